@@ -1,0 +1,3 @@
+from gearcheck.cli import main
+
+raise SystemExit(main())

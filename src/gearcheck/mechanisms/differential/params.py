@@ -1,0 +1,223 @@
+"""Template model of the bevel-gear differential (templates/zhurong_differential.toml).
+
+One pydantic model per section; field names carry units; ranges are physical limits, not the
+paper's window. Geometric rules that need no CAD are checked here (undercut, tip interference,
+pointed tips, contact ratio, face width, common apex, negative warm backlash); each rejection
+is one :class:`ParamError` naming the field, its value and the allowed range.
+"""
+
+from __future__ import annotations
+
+import math
+
+from pydantic import Field, model_validator
+
+from gearcheck.mechanisms.differential import analysis  # numpy only
+from gearcheck.params.common import ParamError, Section
+
+# The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
+# d2/2, a/2 = l2 + d1/2). 0.05 mm is about 3′ of backlash per side (eq 11): within what the
+# shim study (0–0.15 mm) adjusts; a larger mismatch is a different, non-conjugate assembly.
+APEX_TOLERANCE_MM = 0.05
+MAX_STUDY_SHIMS = 12
+MATERIAL_NAME_MAX = 40
+
+
+def _unit(unit: str) -> dict:
+    return {"unit": unit}
+
+
+class Gears(Section):
+    """Two big and two small straight bevel gears, 90° shafts, long/short addendum."""
+
+    module_mm: float = Field(ge=0.5, le=10.0, description="outer (transverse) module m", json_schema_extra=_unit("mm"))
+    big_teeth: int = Field(ge=10, le=200, description="teeth of each big (output) gear, z1", json_schema_extra=_unit("teeth"))
+    small_teeth: int = Field(ge=6, le=200, description="teeth of each small (cross-axis) gear, z2", json_schema_extra=_unit("teeth"))
+    face_width_mm: float = Field(gt=0.0, le=100.0, description="face width along the pitch element", json_schema_extra=_unit("mm"))
+    pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="normal pressure angle α", json_schema_extra=_unit("deg"))
+    shaft_angle_deg: float = Field(description="angle between big and small gear axes; the model needs 90", json_schema_extra=_unit("deg"))
+    small_profile_shift: float = Field(
+        ge=-1.0, le=1.5,
+        description="profile shift coefficient x of the small gear (the big gear gets −x: long/short addendum)",
+        json_schema_extra=_unit("× module"),
+    )
+
+    @model_validator(mode="after")
+    def _rules(self) -> "Gears":
+        if self.shaft_angle_deg != 90.0:
+            raise ParamError("gears.shaft_angle_deg", self.shaft_angle_deg,
+                             "allowed 90 deg only: eqs (1), (6), (7) assume perpendicular big and small gear axes")
+        if self.small_teeth > self.big_teeth:
+            raise ParamError("gears.small_teeth", self.small_teeth,
+                             f"allowed <= big_teeth = {self.big_teeth}: the shimmed big gears are the output gears")
+        geom = analysis.cone_geometry(self.module_mm, self.big_teeth, self.small_teeth)
+        max_face = analysis.MAX_FACE_WIDTH_FRACTION * geom.outer_cone_distance_mm
+        if self.face_width_mm > max_face:
+            raise ParamError("gears.face_width_mm", self.face_width_mm,
+                             f"allowed <= {max_face:.2f} mm: one third of the outer cone distance "
+                             f"Re = {geom.outer_cone_distance_mm:.2f} mm (teeth too thin at the inner end)")
+        alpha = math.radians(self.pressure_angle_deg)
+        mesh = analysis.virtual_mesh(geom, alpha, self.small_profile_shift)
+        x = self.small_profile_shift
+        x_max = analysis.max_small_shift_for_tip(geom, alpha)
+        x_min = max(mesh.small_undercut_min_shift, analysis.min_small_shift_for_interference(geom, alpha))
+        shift_range = f"allowed {x_min:.3f} to {x_max:.3f}"
+        if x < mesh.small_undercut_min_shift:
+            raise ParamError("gears.small_profile_shift", x,
+                             f"{shift_range}: the small gear is undercut "
+                             f"(virtual tooth count z/cos δ = {geom.small_virtual_teeth:.2f} < "
+                             f"{2.0 / math.sin(alpha) ** 2:.1f}); Gleason's rule gives {mesh.gleason_small_shift:.2f}")
+        if mesh.big_tip_path_mm > mesh.big_tip_path_limit_mm:
+            raise ParamError("gears.small_profile_shift", x,
+                             f"{shift_range}: the big gear's tip runs inside the small gear's base circle "
+                             f"(tip interference on the back-cone virtual pair); Gleason's rule gives {mesh.gleason_small_shift:.2f}")
+        min_tip = analysis.MIN_TIP_THICKNESS_MODULES * self.module_mm
+        if mesh.small_tip_thickness_mm < min_tip:
+            raise ParamError("gears.small_profile_shift", x,
+                             f"{shift_range}: pointed teeth, the small gear's tip is "
+                             f"{mesh.small_tip_thickness_mm:.3f} mm thick on the back cone, less than "
+                             f"0.25·m = {min_tip:.3f} mm")
+        if mesh.big_tip_thickness_mm < min_tip:
+            raise ParamError("gears.small_profile_shift", x,
+                             f"too small: pointed teeth, the big gear's tip (shift −x) is "
+                             f"{mesh.big_tip_thickness_mm:.3f} mm thick on the back cone, less than 0.25·m = {min_tip:.3f} mm")
+        if mesh.contact_ratio < analysis.MIN_CONTACT_RATIO:
+            raise ParamError("gears.small_profile_shift", x,
+                             f"contact ratio of the back-cone virtual pair is {mesh.contact_ratio:.3f}, allowed >= "
+                             f"{analysis.MIN_CONTACT_RATIO}: a tooth pair lets go before the next engages "
+                             "(lower the shift or the pressure angle)")
+        return self
+
+
+class Backlash(Section):
+    """Designed backlash at the common apex before shimming (a reconstruction: the paper lost it)."""
+
+    mesh_thinning_min_mm: float = Field(
+        ge=0.0, le=0.5,
+        description="least circumferential tooth thinning of one mesh (big + small gear) on the outer pitch circle",
+        json_schema_extra=_unit("mm"),
+    )
+    mesh_thinning_max_mm: float = Field(
+        ge=0.0, le=0.5,
+        description="largest circumferential tooth thinning of one mesh on the outer pitch circle (tolerance band)",
+        json_schema_extra=_unit("mm"),
+    )
+
+    @model_validator(mode="after")
+    def _band(self) -> "Backlash":
+        if self.mesh_thinning_max_mm < self.mesh_thinning_min_mm:
+            raise ParamError("backlash.mesh_thinning_max_mm", self.mesh_thinning_max_mm,
+                             f"allowed >= mesh_thinning_min_mm = {self.mesh_thinning_min_mm} mm")
+        return self
+
+
+def _cte_field(what: str):
+    return Field(ge=0.0, le=100e-6, description=f"mean linear expansion coefficient of the {what}",
+                 json_schema_extra=_unit("1/K"))
+
+
+class Materials(Section):
+    """Materials and their mean CTE over the warm–cold range (ξ1 housing, ξ2 shaft, ξ3 gears)."""
+
+    housing: str = Field(min_length=1, max_length=MATERIAL_NAME_MAX, description="housing material name")
+    housing_cte_per_K: float = _cte_field("housing (ξ1)")
+    shaft: str = Field(min_length=1, max_length=MATERIAL_NAME_MAX, description="big gear shaft material name")
+    shaft_cte_per_K: float = _cte_field("big gear shaft (ξ2)")
+    gear: str = Field(min_length=1, max_length=MATERIAL_NAME_MAX, description="gear material name")
+    gear_cte_per_K: float = _cte_field("gears (ξ3)")
+
+
+class Dimensions(Section):
+    """Housing and gear mounting lengths of eqs (2)–(7) (the paper's Table 2 is lost: reconstructed)."""
+
+    a_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the small gears' mounting faces", json_schema_extra=_unit("mm"))
+    b_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the big gears' mounting faces", json_schema_extra=_unit("mm"))
+    l11_mm: float = Field(ge=0.0, le=500.0, description="big gear shaft (Ti) length, mounting face to gear joint", json_schema_extra=_unit("mm"))
+    l12_mm: float = Field(ge=0.0, le=500.0, description="big gear body (steel), shaft joint to outer pitch circle plane", json_schema_extra=_unit("mm"))
+    l2_mm: float = Field(ge=0.0, le=500.0, description="small gear, mounting face to outer pitch circle plane", json_schema_extra=_unit("mm"))
+
+
+class Operating(Section):
+    """Temperatures: warm_C is where the backlash is set and measured (room temperature)."""
+
+    warm_C: float = Field(ge=-60, le=150, description="assembly / room temperature where thinning and shim set the backlash", json_schema_extra=_unit("°C"))
+    cold_C: float = Field(ge=-150, le=25, description="cold design point", json_schema_extra=_unit("°C"))
+    operating_min_C: float = Field(ge=-150, le=150, description="lowest operating temperature", json_schema_extra=_unit("°C"))
+    operating_max_C: float = Field(ge=-150, le=150, description="highest operating temperature", json_schema_extra=_unit("°C"))
+    storage_min_C: float = Field(ge=-150, le=150, description="lowest storage temperature", json_schema_extra=_unit("°C"))
+    storage_max_C: float = Field(ge=-150, le=150, description="highest storage temperature", json_schema_extra=_unit("°C"))
+
+    @model_validator(mode="after")
+    def _order(self) -> "Operating":
+        if self.cold_C > self.warm_C:
+            raise ParamError("operating.cold_C", self.cold_C, f"allowed <= warm_C = {self.warm_C} °C")
+        if self.operating_min_C > self.operating_max_C:
+            raise ParamError("operating.operating_min_C", self.operating_min_C,
+                             f"allowed <= operating_max_C = {self.operating_max_C} °C")
+        if self.storage_min_C > self.storage_max_C:
+            raise ParamError("operating.storage_min_C", self.storage_min_C,
+                             f"allowed <= storage_max_C = {self.storage_max_C} °C")
+        return self
+
+
+def shim_key(shim_mm: float) -> str:
+    """JSON key suffix of a study shim: 0.05 → '0p05', 0.1 → '0p10', 0.125 → '0p125'."""
+    text = f"{shim_mm:.3f}".rstrip("0")
+    whole, frac = text.split(".")
+    return f"{whole}p{frac.ljust(2, '0')}"
+
+
+class Shim(Section):
+    """Adjusting shim under each big gear; it moves the gear away from the mesh (eq 11)."""
+
+    thickness_mm: float = Field(ge=0.0, le=1.0, description="shim under each big gear in this design", json_schema_extra=_unit("mm"))
+    study_mm: list[float] = Field(
+        default_factory=list, max_length=MAX_STUDY_SHIMS,
+        description="shims to tabulate (the paper's test: 0, 0.05, 0.10, 0.15)", json_schema_extra=_unit("mm"),
+    )
+
+    @model_validator(mode="after")
+    def _study(self) -> "Shim":
+        seen: dict[str, float] = {}
+        for i, s in enumerate(self.study_mm):
+            if not (0.0 <= s <= 1.0) or not math.isfinite(s):
+                raise ParamError(f"shim.study_mm.{i}", s, "out of range: allowed 0 to 1.0 mm")
+            key = shim_key(s)
+            if key in seen:
+                raise ParamError(f"shim.study_mm.{i}", s,
+                                 f"allowed distinct values at 0.001 mm resolution (same as {seen[key]})")
+            seen[key] = s
+        return self
+
+
+class Params(Section):
+    """The whole template (less its top-level ``mechanism`` key)."""
+
+    gears: Gears
+    backlash: Backlash
+    materials: Materials
+    dimensions: Dimensions
+    operating: Operating
+    shim: Shim
+
+    @model_validator(mode="after")
+    def _assembly(self) -> "Params":
+        geom = analysis.cone_geometry(self.gears.module_mm, self.gears.big_teeth, self.gears.small_teeth)
+        d = self.dimensions
+        b_apex = 2.0 * (d.l11_mm + d.l12_mm + geom.small_pitch_diameter_mm / 2.0)
+        if abs(d.b_mm - b_apex) > APEX_TOLERANCE_MM:
+            raise ParamError("dimensions.b_mm", d.b_mm,
+                             f"allowed {b_apex:.3f} ± {APEX_TOLERANCE_MM} mm: the big pitch circles must meet the "
+                             "common apex, b/2 = l11 + l12 + d2/2 (change l11_mm or l12_mm with it)")
+        a_apex = 2.0 * (d.l2_mm + geom.big_pitch_diameter_mm / 2.0)
+        if abs(d.a_mm - a_apex) > APEX_TOLERANCE_MM:
+            raise ParamError("dimensions.a_mm", d.a_mm,
+                             f"allowed {a_apex:.3f} ± {APEX_TOLERANCE_MM} mm: the small pitch circles must meet the "
+                             "common apex, a/2 = l2 + d1/2 (change l2_mm with it)")
+        gain = analysis.shim_gain(geom, math.radians(self.gears.pressure_angle_deg), self.shim.thickness_mm)
+        warm_min_per_side = analysis.big_gear_arcmin(self.backlash.mesh_thinning_min_mm, geom) + gain.per_side_arcmin
+        if warm_min_per_side <= 0.0:
+            raise ParamError("backlash.mesh_thinning_min_mm", self.backlash.mesh_thinning_min_mm,
+                             f"allowed > 0 mm with shim.thickness_mm = {self.shim.thickness_mm}: the warm backlash "
+                             f"would be {warm_min_per_side:.2f}′ per side (the mesh binds at room temperature)")
+        return self

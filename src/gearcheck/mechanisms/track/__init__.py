@@ -1,0 +1,168 @@
+"""Track-drive sprocket of a bomb-disposal robot (seed 002): ISO 606 groove form, every other
+tooth engaging, short tooth under the track plate; drive force, pin shear and crush stress.
+
+``calc(params)`` returns the figures beside the paper's printed values (``PAPER``); the model and
+its readings are in :mod:`.analysis` and docs/track.md.
+"""
+
+from __future__ import annotations
+
+import math
+
+from gearcheck.figures import Figure
+from gearcheck.geometry import iso606
+from gearcheck.mechanisms.track import analysis
+from gearcheck.mechanisms.track.params import Params
+
+SECTION = "track"
+
+# The paper's printed values (data for the report, never used in the model).
+PAPER = {
+    "teeth_for_initial_pitch_diameter": 48.03,
+    "pitch_diameter_mm": 234.6,
+    "root_diameter_mm": 226.6,
+    "tip_diameter_mm": 235.0,
+    "max_drive_force_N": 234.0,
+}
+
+# Outline sampling for the independent tip-gap measurement; corners are exact vertices anyway.
+GAP_CHECK_STEP_MM = 0.05
+
+
+def _verdict(ok: bool) -> tuple[float, str]:
+    return (1.0 if ok else 0.0), ("pass" if ok else "FAIL")
+
+
+def calc(params: Params) -> list[Figure]:
+    r, gr, ch, sp, tp, mat, st = (params.robot, params.ground, params.chain, params.sprocket,
+                                  params.track_plate, params.materials, params.strength)
+    z, p, dr = sp.teeth, ch.pitch_mm, ch.sleeve_diameter_mm
+    F: list[Figure] = []
+
+    def add(key, label, value, unit, note="", digits=3):
+        F.append(Figure(key, label, float(value), unit, PAPER.get(key), note, digits))
+
+    # --- geometry (eqs. 6-8) ---
+    z_initial = iso606.teeth_for_pitch_diameter(p, sp.initial_pitch_diameter_mm)
+    d = iso606.every_other_tooth_pitch_diameter(p, z)
+    df = d - dr
+    de = d + sp.tip_over_pitch_mm
+    chord = iso606.groove_chord(d, z)
+    add("teeth_for_initial_pitch_diameter", f"z for d = {sp.initial_pitch_diameter_mm:g} mm (eq. 6 inverted)",
+        z_initial, "", f"rounded to odd z = {z}", 2)
+    add("pitch_diameter_mm", "pitch diameter d = p/sin(360°/z)", d, "mm", "every other tooth engages", 2)
+    add("root_diameter_mm", "root diameter df = d − dR", df, "mm", digits=2)
+    add("tip_diameter_mm", "tip diameter de = d + tip rule", de, "mm",
+        f"short tooth: d + {sp.tip_over_pitch_mm:g} mm", 2)
+    add("groove_chord_mm", "chord between adjacent grooves d·sin(180°/z)", chord, "mm",
+        "a link spans two grooves")
+
+    lim = iso606.seating_limits(dr, z)
+    add("iso_seating_radius_min_mm", "ISO 606 seating radius ri min", lim.seating_radius_min_mm, "mm")
+    add("iso_seating_radius_max_mm", "ISO 606 seating radius ri max", lim.seating_radius_max_mm, "mm")
+    add("seating_radius_mm", "chosen seating radius ri (ρf)", sp.seating_radius_mm, "mm", "within ISO limits")
+    add("iso_flank_radius_min_mm", "ISO 606 flank radius re min", lim.flank_radius_min_mm, "mm", digits=2)
+    add("iso_flank_radius_max_mm", "ISO 606 flank radius re max", lim.flank_radius_max_mm, "mm", digits=2)
+    add("flank_radius_mm", "chosen flank radius re", sp.flank_radius_mm, "mm", "within ISO limits", 2)
+    add("iso_seating_angle_min_deg", "ISO 606 seating angle α min", lim.seating_angle_min_deg, "°", digits=2)
+    add("iso_seating_angle_max_deg", "ISO 606 seating angle α max", lim.seating_angle_max_deg, "°", digits=2)
+    add("seating_angle_deg", "chosen seating angle α", sp.seating_angle_deg, "°", "within ISO limits", 2)
+
+    tip_lo_g, tip_hi_g = iso606.iso_tip_diameter_range(d, chord, dr, z)
+    tip_lo_p, tip_hi_p = iso606.iso_tip_diameter_range(d, p, dr, z)
+    add("iso_tip_diameter_min_mm", "ISO 606 tip dia. min (groove chord as pitch)", tip_lo_g, "mm",
+        "not applied: intended short tooth", 2)
+    add("iso_tip_diameter_max_mm", "ISO 606 tip dia. max (groove chord as pitch)", tip_hi_g, "mm",
+        "not applied: intended short tooth", 2)
+    add("iso_tip_diameter_min_chain_pitch_mm", "ISO 606 tip dia. min (chain pitch p)", tip_lo_p, "mm",
+        "not applied: intended short tooth", 2)
+    add("iso_tip_diameter_max_chain_pitch_mm", "ISO 606 tip dia. max (chain pitch p)", tip_hi_p, "mm",
+        "not applied: intended short tooth", 2)
+    add("tip_below_iso_min_mm", "de below the ISO minimum (groove chord)", tip_lo_g - de, "mm",
+        "intended: the tip must stay under the track plate", 2)
+
+    gap = iso606.tooth_gap(d, z, sp.seating_radius_mm, sp.flank_radius_mm, sp.seating_angle_deg, de)
+    add("tip_land_width_mm", "tip land width (arc)", gap.tip_land_width_mm, "mm")
+    add("sleeve_flank_clearance_at_tip_mm", "seated sleeve to tip corner clearance",
+        analysis.sleeve_flank_clearance_at_tip(gap, dr / 2.0), "mm", "sleeve centred on the seating centre")
+    bf_max = iso606.iso_tooth_width_max(ch.sleeve_inner_width_mm, p)
+    add("iso_tooth_width_max_mm", "ISO 606 tooth width bf1 max (from b1)", bf_max, "mm",
+        f"chosen {sp.tooth_width_mm:g} mm")
+
+    # --- track plate over the tip ---
+    pin_line = analysis.link_pin_line_radius(gap)
+    e = analysis.plate_offset_for_tip_gap(gap, tp.tip_gap_mm)
+    outline = iso606.sprocket_outline(gap, GAP_CHECK_STEP_MM)
+    measured = analysis.measured_tip_gap(outline, gap, p, e)
+    add("link_pin_line_radius_mm", "seated link pin line from axis, R·cos(360°/z)", pin_line, "mm")
+    add("plate_offset_mm", "plate face offset e outside the pin line", e, "mm",
+        f"from the chosen gap {tp.tip_gap_mm:g} mm")
+    ok, word = _verdict(tp.required_gap_min_mm <= measured <= tp.required_gap_max_mm)
+    add("tip_gap_mm", "tip gap to plate, measured on the outline", measured, "mm",
+        f"{word}: paper requires {tp.required_gap_min_mm:g}–{tp.required_gap_max_mm:g} mm")
+    add("tip_gap_ok", "tip gap within the paper's window (1 = pass)", ok, "", word, 0)
+
+    # --- loads (eq. 1) ---
+    weight = r.mass_kg * r.g_m_s2
+    drive = analysis.drive_force_N(r.mass_kg, r.g_m_s2, gr.adhesion_coefficient,
+                                   gr.rolling_resistance_coefficient, r.tracks)
+    normal = weight / r.tracks
+    design = max(normal, drive)
+    add("weight_N", "robot weight G = m·g", weight, "N", f"g = {r.g_m_s2:g} m/s²", 1)
+    add("max_drive_force_N", "max drive force per track P_Kφ = (φ − f)G/n", drive, "N",
+        "eq. 1 lost: (φ − f)G/n, within 1 % of 234 N at g = 10; no slope term", 1)
+    add("normal_load_per_track_N", "normal load per track G/n", normal, "N", "level ground (largest)", 1)
+    add("design_load_N", "design load F = max(G/n, P_Kφ), one tooth", design, "N", digits=1)
+    need = analysis.required_adhesion(r.slope_deg, gr.rolling_resistance_coefficient)
+    climbable = gr.adhesion_coefficient >= need
+    ok, word = _verdict(climbable)
+    add("required_adhesion_for_slope", f"adhesion needed for {r.slope_deg:g}°: tan α + f", need, "",
+        f"{word}: φ = {gr.adhesion_coefficient:g}" + ("" if climbable else " — the paper's slope cannot be climbed"))
+    add("max_slope_by_adhesion_deg", "steepest slope adhesion allows, atan(φ − f)",
+        analysis.max_slope_deg(gr.adhesion_coefficient, gr.rolling_resistance_coefficient), "°", digits=1)
+    add("climb_force_needed_N", f"drive force per track to climb {r.slope_deg:g}°",
+        analysis.climb_force_needed_N(r.mass_kg, r.g_m_s2, r.slope_deg, gr.rolling_resistance_coefficient,
+                                      r.tracks), "N", "G(sin α + f cos α)/n", 1)
+    add("slope_climbable", "slope climbable by adhesion (1 = pass)", ok, "", word, 0)
+    add("sprocket_speed_rpm", "sprocket speed at v", r.speed_m_s * 60_000.0 / (math.pi * d), "rpm", digits=1)
+    add("drive_torque_per_track_Nm", "sprocket torque at P_Kφ", drive * d / 2000.0, "N·m", digits=2)
+    add("drive_power_per_track_W", "drive power per track P_Kφ·v", drive * r.speed_m_s, "W", digits=0)
+
+    # --- pin shear ---
+    tau = analysis.pin_shear_stress_MPa(drive, ch.pin_segments, ch.pin_diameter_mm)
+    ok, word = _verdict(tau <= st.pin_allowable_shear_MPa)
+    add("pin_shear_stress_MPa", "pin shear stress 4V/3A (P_Kφ)", tau, "MPa",
+        f"{ch.pin_segments} simply supported segments, uniform q", 2)
+    add("pin_allowable_shear_MPa", "pin allowable shear [τ]", st.pin_allowable_shear_MPa, "MPa", digits=0)
+    add("pin_shear_safety_factor", "pin shear safety factor [τ]/τ", st.pin_allowable_shear_MPa / tau, "", word, 2)
+    add("pin_shear_ok", "pin shear (1 = pass)", ok, "", word, 0)
+    add("pin_bending_stress_MPa", "pin bending stress (info)",
+        analysis.pin_bending_stress_MPa(drive, ch.pin_segments, ch.sleeve_inner_width_mm,
+                                        ch.pin_support_span_mm, ch.pin_diameter_mm),
+        "MPa", "span b2, load over b1; the paper checks shear only", 1)
+
+    # --- crush stress (eq. 10) ---
+    sleeve_r = dr / 2.0
+    length = sp.tooth_width_mm * st.loaded_tooth_rows
+    elastic = (mat.sleeve_E_MPa, mat.sleeve_poisson, mat.sprocket_E_MPa, mat.sprocket_poisson)
+    rho_max = lim.seating_radius_max_mm
+    concave = analysis.hertz_line_contact(design, length, 1.0 / sleeve_r - 1.0 / rho_max, *elastic)
+    chosen = analysis.hertz_line_contact(design, length, 1.0 / sleeve_r - 1.0 / sp.seating_radius_mm, *elastic)
+    convex = analysis.hertz_line_contact(design, length, 1.0 / sleeve_r + 1.0 / rho_max, *elastic)
+    ok, word = _verdict(concave.peak_pressure_MPa <= st.allowable_crush_stress_MPa)
+    add("crush_stress_MPa", "crush stress, sleeve in groove (concave, ρf = ri max)", concave.peak_pressure_MPa,
+        "MPa", "1/ρ = 1/R − 1/ρf; paper: largest groove for safety", 1)
+    add("crush_stress_chosen_groove_MPa", "crush stress at the chosen ri (info)", chosen.peak_pressure_MPa,
+        "MPa", digits=1)
+    add("crush_stress_convex_sum_MPa", "crush stress if curvatures summed (alternative)",
+        convex.peak_pressure_MPa, "MPa", "1/R + 1/ρf: not the physical contact; upper bound", 1)
+    add("contact_half_width_mm", "Hertz contact half-width a (concave)", concave.half_width_mm, "mm",
+        f"a/R = {concave.half_width_mm / sleeve_r:.2f}: line-contact Hertz applies")
+    add("crush_allowable_MPa", "allowable crush stress", st.allowable_crush_stress_MPa, "MPa", digits=0)
+    add("crush_safety_factor", "crush safety factor", st.allowable_crush_stress_MPa / concave.peak_pressure_MPa,
+        "", word, 2)
+    add("crush_ok", "crush stress (1 = pass)", ok, "", word, 0)
+    return F
+
+
+__all__ = ["SECTION", "Params", "calc", "PAPER"]

@@ -1,0 +1,177 @@
+"""Template model of the track-drive sprocket (seed 002): every input of the paper, nothing derived.
+
+Field ranges are physical limits; the cross-field rules (odd tooth count, a tooth left between
+adjacent grooves, the ISO 606 seating limits, a tip land left under the tip circle, widths that
+fit) live in :class:`Params` and each raise one :class:`ParamError` naming the field, the value
+and the allowed range computed from the other inputs.
+"""
+
+from __future__ import annotations
+
+from pydantic import Field, model_validator
+
+from gearcheck.geometry import iso606
+from gearcheck.params import ParamError, Section
+
+MIN_TEETH = 7
+MAX_TEETH = 301
+
+
+def _f(lo=None, hi=None, *, gt=None, lt=None, unit="", description=""):
+    return Field(ge=lo, le=hi, gt=gt, lt=lt, description=description, json_schema_extra={"unit": unit})
+
+
+class Robot(Section):
+    mass_kg: float = _f(gt=0, hi=100_000, unit="kg", description="total mass incl. payload (paper: 150 kg)")
+    speed_m_s: float = _f(gt=0, hi=50, unit="m/s", description="design travel speed v")
+    slope_deg: float = _f(0, lt=90, unit="°", description="slope the robot is meant to climb, α")
+    tracks: int = _f(1, 16, description="tracks sharing the load, n (paper: 2 or 4)")
+    g_m_s2: float = _f(0.1, 30, unit="m/s²", description="gravity; the paper's 234 N implies 10")
+
+
+class Ground(Section):
+    adhesion_coefficient: float = _f(gt=0, hi=2, description="adhesion coefficient φ")
+    rolling_resistance_coefficient: float = _f(0, 1, description="rolling resistance coefficient f")
+
+
+class Chain(Section):
+    """The articulated track read as a roller chain (ISO 606 symbols in brackets)."""
+
+    pitch_mm: float = _f(gt=0, hi=500, unit="mm", description="track pitch p")
+    sleeve_diameter_mm: float = _f(gt=0, hi=200, unit="mm", description="sleeve (roller) diameter dR [d1]")
+    pin_diameter_mm: float = _f(gt=0, hi=100, unit="mm", description="track pin diameter d")
+    sleeve_inner_width_mm: float = _f(gt=0, hi=500, unit="mm",
+                                      description="b1: sleeve length between the supporting lugs [b1]")
+    pin_support_span_mm: float = _f(gt=0, hi=500, unit="mm",
+                                    description="b2: span of a pin segment between its supports [b2]")
+    pin_segments: int = _f(1, 8, description="pin segments, each a simply supported beam (one per tooth row)")
+    track_width_mm: float = _f(gt=0, hi=2000, unit="mm", description="track width")
+
+
+class Sprocket(Section):
+    teeth: int = _f(MIN_TEETH, MAX_TEETH, description="teeth z (odd: every other tooth engages)")
+    initial_pitch_diameter_mm: float = _f(gt=0, hi=10_000, unit="mm",
+                                          description="first estimate of d that z is solved from (paper: 230)")
+    tip_over_pitch_mm: float = _f(0, 100, unit="mm", description="short-tooth rule: de = d + this (paper: 0.4)")
+    seating_radius_mm: float = _f(gt=0, hi=100, unit="mm", description="chosen seating radius ri (ρf)")
+    flank_radius_mm: float = _f(gt=0, hi=100_000, unit="mm", description="chosen flank radius re")
+    seating_angle_deg: float = _f(gt=90, lt=180, unit="°", description="chosen seating angle α")
+    tooth_width_mm: float = _f(gt=0, hi=500, unit="mm", description="width of one tooth row bf1")
+    tooth_rows: int = _f(1, 4, description="rows of teeth (paper: 2)")
+    middle_groove_width_mm: float = _f(0, 500, unit="mm",
+                                       description="annular groove between rows for the guide lugs")
+
+
+class TrackPlate(Section):
+    tip_gap_mm: float = _f(0.05, 5, unit="mm", description="chosen gap from tooth tip to a seated link's plate")
+    required_gap_min_mm: float = _f(0, 5, unit="mm", description="paper's required gap, lower end")
+    required_gap_max_mm: float = _f(0, 5, unit="mm", description="paper's required gap, upper end")
+
+
+class Materials(Section):
+    sprocket_E_MPa: float = _f(1_000, 500_000, unit="MPa", description="sprocket modulus E2 (7075-T651)")
+    sprocket_poisson: float = _f(0, lt=0.5, description="sprocket Poisson ratio μ2")
+    sleeve_E_MPa: float = _f(1_000, 500_000, unit="MPa", description="sleeve modulus E1 (paper: 7075-T651)")
+    sleeve_poisson: float = _f(0, lt=0.5, description="sleeve Poisson ratio μ1")
+
+
+class Strength(Section):
+    pin_allowable_shear_MPa: float = _f(gt=0, hi=5_000, unit="MPa", description="pin [τ] (stainless)")
+    allowable_crush_stress_MPa: float = _f(gt=0, hi=10_000, unit="MPa",
+                                           description="allowable Hertz crush stress of the sprocket groove")
+    loaded_tooth_rows: int = _f(1, 4, description="tooth rows assumed to carry the load at one groove")
+
+
+class Params(Section):
+    robot: Robot
+    ground: Ground
+    chain: Chain
+    sprocket: Sprocket
+    track_plate: TrackPlate
+    materials: Materials
+    strength: Strength
+
+    @model_validator(mode="after")
+    def _cross_checks(self) -> "Params":
+        s, c = self.sprocket, self.chain
+        z, p, dr = s.teeth, c.pitch_mm, c.sleeve_diameter_mm
+        if z % 2 == 0:
+            raise ParamError("sprocket.teeth", z,
+                             f"allowed odd numbers {MIN_TEETH} to {MAX_TEETH}: with every other tooth "
+                             "engaging, an odd z lets each tooth take its turn (wear alternates)")
+        if not c.pin_diameter_mm < dr:
+            raise ParamError("chain.pin_diameter_mm", c.pin_diameter_mm,
+                             f"allowed < sleeve diameter {dr:g} mm (the pin runs inside the sleeve)")
+        if not s.initial_pitch_diameter_mm > p:
+            raise ParamError("sprocket.initial_pitch_diameter_mm", s.initial_pitch_diameter_mm,
+                             f"allowed > chain pitch {p:g} mm")
+        d = iso606.every_other_tooth_pitch_diameter(p, z)
+        chord = iso606.groove_chord(d, z)
+        lim = iso606.seating_limits(dr, z)
+        # No tooth is left when even the smallest ISO seating circles (0.505·dR) of adjacent
+        # grooves touch.
+        if not lim.seating_radius_min_mm * 2.0 < chord:
+            raise ParamError("chain.sleeve_diameter_mm", dr,
+                             f"allowed < {chord / 1.01:.3f} mm at z = {z}, p = {p:g} mm: seating circles "
+                             f"(0.505·dR) of adjacent grooves {chord:.3f} mm apart must leave a tooth")
+        ri_hi = min(lim.seating_radius_max_mm, 0.5 * chord)
+        if not lim.seating_radius_min_mm <= s.seating_radius_mm <= ri_hi:
+            bound = "" if ri_hi == lim.seating_radius_max_mm else f" (capped at half the groove chord {chord:.3f} mm)"
+            raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm,
+                             f"allowed {lim.seating_radius_min_mm:.3f} to {ri_hi:.3f} mm: ISO 606 limits "
+                             f"for dR = {dr:g} mm{bound}")
+        if not lim.flank_radius_min_mm <= s.flank_radius_mm <= lim.flank_radius_max_mm:
+            raise ParamError("sprocket.flank_radius_mm", s.flank_radius_mm,
+                             f"allowed {lim.flank_radius_min_mm:.2f} to {lim.flank_radius_max_mm:.2f} mm: "
+                             f"ISO 606 limits for dR = {dr:g} mm, z = {z}")
+        if not lim.seating_angle_min_deg <= s.seating_angle_deg <= lim.seating_angle_max_deg:
+            raise ParamError("sprocket.seating_angle_deg", s.seating_angle_deg,
+                             f"allowed {lim.seating_angle_min_deg:.2f} to {lim.seating_angle_max_deg:.2f}°: "
+                             f"ISO 606 limits for z = {z}")
+        self._check_tip_land(d)
+        bf_max = iso606.iso_tooth_width_max(c.sleeve_inner_width_mm, p)
+        if not s.tooth_width_mm <= bf_max:
+            raise ParamError("sprocket.tooth_width_mm", s.tooth_width_mm,
+                             f"allowed <= {bf_max:.3f} mm: ISO 606 bf1 max for b1 = {c.sleeve_inner_width_mm:g} mm")
+        if not c.sleeve_inner_width_mm < c.pin_support_span_mm:
+            raise ParamError("chain.sleeve_inner_width_mm", c.sleeve_inner_width_mm,
+                             f"allowed < pin support span b2 = {c.pin_support_span_mm:g} mm")
+        total = s.tooth_rows * s.tooth_width_mm + (s.tooth_rows - 1) * s.middle_groove_width_mm
+        if not total <= c.track_width_mm:
+            raise ParamError("sprocket.middle_groove_width_mm", s.middle_groove_width_mm,
+                             f"rows and grooves span {total:g} mm; allowed total <= track width "
+                             f"{c.track_width_mm:g} mm")
+        if not self.strength.loaded_tooth_rows <= s.tooth_rows:
+            raise ParamError("strength.loaded_tooth_rows", self.strength.loaded_tooth_rows,
+                             f"allowed 1 to {s.tooth_rows} (sprocket.tooth_rows)")
+        g = self.ground
+        if not g.adhesion_coefficient > g.rolling_resistance_coefficient:
+            raise ParamError("ground.adhesion_coefficient", g.adhesion_coefficient,
+                             f"allowed > rolling resistance f = {g.rolling_resistance_coefficient:g} "
+                             "(else the track has no drive force)")
+        t = self.track_plate
+        if not t.required_gap_min_mm <= t.required_gap_max_mm:
+            raise ParamError("track_plate.required_gap_min_mm", t.required_gap_min_mm,
+                             f"allowed <= required_gap_max_mm = {t.required_gap_max_mm:g} mm")
+        return self
+
+    def _check_tip_land(self, d: float) -> None:
+        """The tip circle must cut the flanks below the point where adjacent flanks meet."""
+        s = self.sprocket
+        limit = iso606.tip_land_limit_diameter(d, s.teeth, s.seating_radius_mm, s.flank_radius_mm,
+                                               s.seating_angle_deg)
+        if not d + s.tip_over_pitch_mm < limit:
+            if limit <= d:
+                raise ParamError("sprocket.tip_over_pitch_mm", s.tip_over_pitch_mm,
+                                 f"no value >= 0 allowed: the flanks of adjacent grooves meet "
+                                 f"{(d - limit) / 2:.3f} mm below the pitch circle (sleeve "
+                                 f"{self.chain.sleeve_diameter_mm:g} mm too large for the "
+                                 f"{iso606.groove_chord(d, s.teeth):.3f} mm groove chord with this ri, re, α)")
+            raise ParamError("sprocket.tip_over_pitch_mm", s.tip_over_pitch_mm,
+                             f"allowed < {limit - d:.3f} mm: the flanks of adjacent grooves meet "
+                             f"{(limit - d) / 2:.3f} mm above the pitch circle, no tip land above that")
+        try:
+            iso606.tooth_gap(d, s.teeth, s.seating_radius_mm, s.flank_radius_mm, s.seating_angle_deg,
+                             d + s.tip_over_pitch_mm)
+        except iso606.ToothFormError as exc:  # not reachable inside the ISO limits; kept as a guard
+            raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm, f"no valid tooth: {exc}") from None

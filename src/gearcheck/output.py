@@ -1,0 +1,44 @@
+"""Atomic output: write to a temporary file in the target folder, then rename."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from gearcheck.params import ParamError
+
+
+def ensure_out_dir(folder: Path) -> Path:
+    """Create ``folder`` (and parents); a bad target is a ParamError naming ``--out``."""
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise ParamError("--out", str(folder), "exists and is not a folder")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ParamError("--out", str(folder), f"cannot create folder: {exc.strerror}") from None
+    if not os.access(folder, os.W_OK):
+        raise ParamError("--out", str(folder), "folder is not writable")
+    return folder
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except FileNotFoundError:
+            pass
+        raise
+
+
+def atomic_write_text(path: Path, text: str) -> None:
+    atomic_write_bytes(path, text.encode("utf-8"))

@@ -1,0 +1,1 @@
+"""Collision sweeps (python-fcl): meshes and poses in, clearances and contact poses out."""

@@ -1,0 +1,57 @@
+"""The FCL layer alone, on meshes whose answers are known exactly (boxes: flat faces, no chord error)."""
+
+import numpy as np
+import pytest
+
+from gearcheck.sweep.engine import MeshData, Scene, bisect_contact
+
+
+def box(name, size):
+    sx, sy, sz = (s / 2 for s in size)
+    v = np.array([[x, y, z] for x in (-sx, sx) for y in (-sy, sy) for z in (-sz, sz)], float)
+    f = np.array([[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5], [0, 4, 5], [0, 5, 1],
+                  [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 5, 7], [1, 7, 3]])
+    return MeshData(name, v, f)
+
+
+def translation(x, y=0.0, z=0.0):
+    t = np.eye(4)
+    t[:3, 3] = (x, y, z)
+    return t
+
+
+def test_distance_and_nearest_points():
+    scene = Scene([box("a", (2, 2, 2)), box("b", (2, 2, 2))])
+    scene.set_pose("b", translation(2.5))
+    d = scene.distance("a", "b")
+    assert d.distance == pytest.approx(0.5, abs=1e-9)
+    assert d.point_a[0] == pytest.approx(1.0, abs=1e-9)
+    assert d.point_b[0] == pytest.approx(1.5, abs=1e-9)
+    assert not scene.collide("a", "b")
+    scene.set_pose("b", translation(1.9))
+    assert scene.collide("a", "b")
+
+
+def test_bisection_finds_contact_from_both_sides():
+    scene = Scene([box("a", (2, 2, 2)), box("b", (1, 1, 1))])
+
+    def collides(x):
+        scene.set_pose("b", translation(x))
+        return scene.collide("a", "b")
+
+    # touching=1.2 overlaps partly: FCL mesh–mesh tests surface triangles, so a body wholly
+    # inside another is not a collision (sweep steps must stay small against tooth size).
+    bracket = bisect_contact(collides, free=3.0, touching=1.2, tol=1e-7)
+    assert bracket.value == pytest.approx(1.5, abs=1e-6)
+    assert not collides(bracket.free) and collides(bracket.touching)
+
+
+def test_bisection_refuses_a_pair_that_never_touches():
+    scene = Scene([box("a", (2, 2, 2)), box("b", (1, 1, 1))])
+
+    def collides(x):
+        scene.set_pose("b", translation(x))
+        return scene.collide("a", "b")
+
+    with pytest.raises(ValueError, match="does not reach contact"):
+        bisect_contact(collides, free=5.0, touching=4.0)
