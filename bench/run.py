@@ -41,6 +41,44 @@ def bench_calc(repeat: int) -> dict:
     return out
 
 
+def bench_build(repeat: int) -> dict:
+    """CAD build time per part kind (median of ``repeat``), cadquery imported once beforehand."""
+    import cadquery  # noqa: F401  (import cost kept out of the figures)
+
+    from gearcheck.cad.bevel import build_bevel_gear
+    from gearcheck.cad.rack_pinion import build_pinion, build_rack
+    from gearcheck.cad.sprocket import build_sprocket, sprocket_spec
+    from gearcheck.mechanisms.differential.poses import gear_specs
+    from gearcheck.mechanisms.steering.analysis import geometry_from_params
+
+    diff = load_template(ROOT / "templates" / "zhurong_differential.toml").params
+    track = load_template(ROOT / "templates" / "eod_track_drive.toml").params
+    steer = load_template(ROOT / "templates" / "nose_wheel_steering.toml").params
+    specs = gear_specs(diff)
+    g = geometry_from_params(steer)
+    spec = sprocket_spec(track)
+    return {
+        "bevel_gear_z33": median_time(lambda: build_bevel_gear(specs.big), repeat),
+        "bevel_gear_z13": median_time(lambda: build_bevel_gear(specs.small), repeat),
+        "sprocket_z49": median_time(lambda: build_sprocket(spec), repeat),
+        "pinion_z42": median_time(lambda: build_pinion(g), repeat),
+        "rack": median_time(lambda: build_rack(g), repeat),
+    }
+
+
+def bench_build_all(repeat: int) -> dict:
+    """`gearcheck build --all` wall time in a fresh process (includes import cadquery)."""
+    import subprocess
+    import tempfile
+
+    def run():
+        with tempfile.TemporaryDirectory() as tmp:
+            subprocess.run([sys.executable, "-m", "gearcheck", "build", "--all", "--out", tmp],
+                           cwd=ROOT, check=True, capture_output=True)
+
+    return median_time(run, repeat)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench.json")
@@ -53,10 +91,14 @@ def main() -> int:
         "machine": platform.machine(),
         "cpus": __import__("os").cpu_count(),
         "calc": bench_calc(args.repeat),
+        "build": bench_build(3),
+        "build_all_wall": bench_build_all(3),
     }
     atomic_write_text(args.out, json.dumps(result, indent=2) + "\n")
-    for name, fig in result["calc"].items():
-        print(f"calc {name:28s} median {fig['median_s'] * 1e3:8.1f} ms")
+    for group in ("calc", "build"):
+        for name, fig in result[group].items():
+            print(f"{group:5s} {name:28s} median {fig['median_s'] * 1e3:8.1f} ms")
+    print(f"build --all (fresh process)         median {result['build_all_wall']['median_s']:8.2f} s")
     print(f"wrote {args.out}")
     return 0
 

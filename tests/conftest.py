@@ -6,6 +6,6 @@ ROOT = Path(__file__).resolve().parents[1]
 TEMPLATES = ROOT / "templates"
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def templates_dir() -> Path:
     return TEMPLATES

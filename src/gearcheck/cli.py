@@ -66,9 +66,28 @@ def build_parser() -> argparse.ArgumentParser:
     _add_template_args(calc)
     calc.add_argument("--json", action="store_true", help="print one JSON object (nested by section) instead of a table")
 
-    demo = sub.add_parser("demo", help="run every template in templates/ and write results under --out")
+    build = sub.add_parser(
+        "build",
+        help="build the CAD: STEP assembly, one STL per part, manifest.json",
+        description="Build the mechanism's parts with CadQuery from the template (exact involute "
+        "flanks), mesh each part with an absolute chordal tolerance, and write DIR/NAME.step "
+        "(named, placed parts), DIR/PART.stl, DIR/params.toml (the resolved parameters) and "
+        "DIR/manifest.json (materials, volumes, triangle counts, measured mesh error, file hashes). "
+        "Every file is written atomically.",
+    )
+    build.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
+    build.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                       help="override one template value (repeatable)")
+    build.add_argument("--all", action="store_true", help="build every template in templates/ into OUT/NAME")
+    build.add_argument("--out", type=Path, default=None,
+                       help="output folder (default out/NAME; with --all, the parent folder, default out)")
+    build.add_argument("--tol", type=float, default=None, metavar="MM",
+                       help="absolute chordal tolerance of the STL meshes in mm (default 0.01)")
+
+    demo = sub.add_parser("demo", help="every template in templates/: figures and CAD under --out (what `make demo` runs)")
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
     demo.add_argument("--templates", type=Path, default=TEMPLATE_DIR, help="folder of templates (default: templates)")
+    demo.add_argument("--no-cad", action="store_true", help="analytical figures only, no CAD build")
     return parser
 
 
@@ -85,26 +104,72 @@ def cmd_calc(args) -> int:
 
 
 def cmd_demo(args) -> int:
+    """Every template: the analytical figures (calc.json, calc.txt) and the CAD (build)."""
     from gearcheck.mechanisms import load_template
     from gearcheck.output import atomic_write_text, ensure_out_dir
 
     templates = sorted(args.templates.glob("*.toml"))
     if not templates:
         raise ParamError("--templates", str(args.templates), "no *.toml templates found there")
-    for path in templates:
-        loaded = load_template(path)
-        figures = loaded.module.calc(loaded.params)
-        folder = ensure_out_dir(args.out / loaded.name)
-        atomic_write_text(folder / "calc.json", json.dumps(figures_to_json(loaded.module.SECTION, figures), indent=2, allow_nan=False) + "\n")
-        table = render_table(f"{loaded.name} ({loaded.mechanism}) — analytical model", figures)
+    loaded = [load_template(path) for path in templates]  # validate every template first
+    for item in loaded:
+        figures = item.module.calc(item.params)
+        folder = ensure_out_dir(args.out / item.name)
+        atomic_write_text(folder / "calc.json", json.dumps(figures_to_json(item.module.SECTION, figures), indent=2, allow_nan=False) + "\n")
+        table = render_table(f"{item.name} ({item.mechanism}) — analytical model", figures)
         atomic_write_text(folder / "calc.txt", table + "\n")
         print(table)
         print()
-    print(f"wrote {len(templates)} result folders under {args.out}/")
+        if not args.no_cad:
+            _build_one(item, folder, None)
+            print()
+    print(f"wrote {len(loaded)} result folders under {args.out}/")
     return 0
 
 
-COMMANDS = {"calc": cmd_calc, "demo": cmd_demo}
+def _build_one(loaded, folder: Path, tol_mm: float | None) -> dict:
+    from tqdm import tqdm
+
+    from gearcheck.cad.export import export_parts
+    from gearcheck.cad.mesh import CHORDAL_TOL_MM
+
+    print(f"building {loaded.name} ({loaded.mechanism}) ...", file=sys.stderr)
+    parts = loaded.parts_module.build_parts(loaded.params)
+    with tqdm(total=len(parts), desc=f"meshing {loaded.name}", unit="part", file=sys.stderr,
+              disable=not sys.stderr.isatty()) as bar:
+        manifest = export_parts(
+            parts, folder, name=loaded.name, mechanism=loaded.mechanism, params_data=loaded.data,
+            tol_mm=tol_mm if tol_mm is not None else CHORDAL_TOL_MM,
+            progress=lambda _name: bar.update(1),
+        )
+    print(f"wrote {folder}/ : {len(parts)} parts, {manifest['step']['file']}, manifest.json")
+    return manifest
+
+
+def _check_tol(tol: float | None) -> None:
+    if tol is not None and not (0.0005 <= tol <= 0.5):
+        raise ParamError("--tol", tol, "out of range: allowed 0.0005 to 0.5 mm")
+
+
+def cmd_build(args) -> int:
+    from gearcheck.mechanisms import load_template
+
+    _check_tol(args.tol)
+    if args.all == (args.template is not None):
+        raise ParamError("build", str(args.template), "give one TEMPLATE or --all, not both or neither")
+    if args.all:
+        templates = sorted(TEMPLATE_DIR.glob("*.toml"))
+        loaded = [load_template(t, args.overrides) for t in templates]  # validate all first
+        root = args.out or Path("out")
+        for item in loaded:
+            _build_one(item, root / item.name, args.tol)
+        return 0
+    loaded = load_template(args.template, args.overrides)
+    _build_one(loaded, args.out or Path("out") / loaded.name, args.tol)
+    return 0
+
+
+COMMANDS = {"calc": cmd_calc, "build": cmd_build, "demo": cmd_demo}
 
 
 def main(argv: list[str] | None = None) -> int:

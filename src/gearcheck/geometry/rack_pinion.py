@@ -327,3 +327,71 @@ class RackPinionGeometry:
         k1, k2 = self.rack_first_tooth, self.rack_first_tooth + 1
         t1, t2 = self.rack_tooth_polygon(k1, travel), self.rack_tooth_polygon(k2, travel)
         return {"S2": t1[3], "S6": t1[2], "S4": t2[3], "S8": t2[2]}
+
+
+# --- pinion tooth pieces for a B-rep (pure; consumed by gearcheck.cad.rack_pinion) -----------
+# The pinion's own frame: centre at the origin, polar angle γ from straight down (−y),
+# counter-clockwise; tooth j's centre line at γ = (j + ½)·τ. The world pinion at angle φ is this
+# frame turned by φ about its axis and moved to (0, H).
+
+@dataclass(frozen=True)
+class ToothPiece:
+    """One piece of a pinion tooth outline, as (ρ, γ relative to the tooth centre line).
+
+    ``kind``: "fillet" (trochoid, interpolate), "involute" (interpolate), "tip" (an arc of the
+    tip circle: exactly three points, start, middle, end)."""
+
+    kind: str
+    rho: np.ndarray
+    gamma: np.ndarray
+
+
+def pinion_tooth_pieces(g: RackPinionGeometry, j: int, flank_points: int, fillet_points: int) -> list[ToothPiece]:
+    """Pinion tooth j's outline above the root circle, counter-clockwise (increasing γ): left
+    fillet (root → form), left involute (form → tip), tip arc, right involute (tip → form), right
+    fillet (form → root). ``flank_points`` exact involute points per flank, evenly spaced in roll
+    angle; ``fillet_points`` exact trochoid points. Consecutive pieces share their end points
+    bit for bit (the outline closes without tolerance). The root land between two teeth is the
+    root circle from γ = +``pinion_root_land_start(g)`` of one tooth to −that of the next."""
+    r_tip = g.pinion_tip_radius(j)
+    radii = g._involute_radii(g.form_radius, r_tip, flank_points - 1)
+    beta = g.involute_half_angle(radii)
+    f_rho, f_gam = g.pinion_fillet_polar(fillet_points - 1)  # root → form, right side
+    f_rho, f_gam = f_rho.copy(), f_gam.copy()
+    f_rho[-1], f_gam[-1] = radii[0], beta[0]  # the fillet ends where the involute starts
+    tip = np.array([beta[-1], 0.0, -beta[-1]])
+    return [
+        ToothPiece("fillet", f_rho, -f_gam),
+        ToothPiece("involute", radii, -beta),
+        ToothPiece("tip", np.full(3, r_tip), -tip),
+        ToothPiece("involute", radii[::-1], beta[::-1]),
+        ToothPiece("fillet", f_rho[::-1], f_gam[::-1]),
+    ]
+
+
+def pinion_root_land_start(g: RackPinionGeometry) -> float:
+    """|γ| (from the tooth centre line) where the trochoid fillet leaves the root circle."""
+    return float(g.pinion_fillet_polar(1)[1][0])
+
+
+def pinion_local_xy(rho, gamma) -> np.ndarray:
+    """Points of the pinion's own frame (centre at the origin) at radius ρ and polar angle γ
+    (from straight down, counter-clockwise): (ρ sin γ, −ρ cos γ)."""
+    rho = np.asarray(rho, dtype=float)
+    gamma = np.asarray(gamma, dtype=float)
+    return np.stack([rho * np.sin(gamma), -rho * np.cos(gamma)], axis=-1)
+
+
+def pinion_local_polar(xy) -> tuple[np.ndarray, np.ndarray]:
+    """Inverse of :func:`pinion_local_xy`: (ρ, γ) of points (..., 2) in the pinion's frame."""
+    xy = np.asarray(xy, dtype=float)
+    return np.hypot(xy[..., 0], xy[..., 1]), np.arctan2(xy[..., 0], -xy[..., 1])
+
+
+def involute_flank_distance(g: RackPinionGeometry, rho, gamma_rel, side: int) -> np.ndarray:
+    """Exact signed normal distance (mm, + outside the tooth material) from points at (ρ, γ
+    relative to a tooth centre line) to that tooth's involute flank (side +1: right, at γ = +β(ρ);
+    −1: left). Involutes of one base circle are parallel curves, rb·δ apart when their start
+    angles differ by δ, so the distance is rb·(γ − side·β(ρ))·side, exact for every ρ ≥ rb."""
+    beta = g.involute_half_angle(rho)
+    return side * g.base_radius * (np.asarray(gamma_rel, dtype=float) - side * beta)

@@ -42,6 +42,11 @@ class Loaded:
         return mechanism_module(self.mechanism)
 
     @property
+    def parts_module(self) -> ModuleType:
+        """``build_parts(params) -> list[Part]``: imports CadQuery, so only loaded on demand."""
+        return importlib.import_module(MECHANISMS[self.mechanism] + ".parts")
+
+    @property
     def name(self) -> str:
         return self.path.stem
 

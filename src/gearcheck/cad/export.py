@@ -1,0 +1,138 @@
+"""Export a mechanism's parts: STEP assembly (mm, named parts), one STL per part, manifest.json.
+
+Every file is written to a temporary name in the target folder and renamed into place, and the
+manifest is written last, so an interrupted build never leaves a half-written file or a manifest
+describing files that are not there.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import cadquery as cq
+import numpy as np
+
+from gearcheck import __version__
+from gearcheck.cad.mesh import CHORDAL_TOL_MM, TriMesh, mesh_shape
+from gearcheck.cad.placement import Part, location
+from gearcheck.output import atomic_write_bytes, atomic_write_text, ensure_out_dir, temp_path_beside
+from gearcheck.params.common import to_toml
+
+
+@dataclass(frozen=True)
+class ExportedPart:
+    part: Part
+    mesh: TriMesh  # in the part's own frame; the STL holds it moved by the part's pose
+    stl: Path
+    brep_volume_mm3: float
+
+
+def posed(mesh: TriMesh, pose: np.ndarray) -> TriMesh:
+    """The mesh moved by a rigid 4×4 pose (volume, error and winding unchanged)."""
+    vertices = mesh.vertices @ pose[:3, :3].T + pose[:3, 3]
+    return replace(mesh, vertices=vertices)
+
+
+def stl_bytes(mesh: TriMesh, name: str) -> bytes:
+    """Binary STL of an indexed mesh (deterministic: no timestamp in the header)."""
+    tri = mesh.vertices[mesh.faces]
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    lengths = np.linalg.norm(normals, axis=1)
+    normals = np.divide(normals, lengths[:, None], out=np.zeros_like(normals), where=lengths[:, None] > 0)
+    record = np.dtype([("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    data = np.zeros(len(tri), dtype=record)
+    data["n"] = normals
+    data["v"] = tri
+    header = f"gearcheck {__version__} {name} mm".encode("ascii", "replace")[:80].ljust(80, b" ")
+    return header + np.uint32(len(tri)).tobytes() + data.tobytes()
+
+
+def sha256(path: Path) -> str:
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def write_step(parts: list[Part], path: Path, assembly_name: str) -> None:
+    """STEP assembly with one named, coloured component per part (mm), written atomically."""
+    assy = cq.Assembly(name=assembly_name)
+    for part in parts:
+        assy.add(part.solid, name=part.name, loc=location(part.pose), color=cq.Color(*part.color))
+    tmp = temp_path_beside(path)
+    try:
+        assy.export(str(tmp), exportType="STEP", unit="MM")
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def export_parts(
+    parts: list[Part],
+    folder: Path,
+    *,
+    name: str,
+    mechanism: str,
+    params_data: dict,
+    tol_mm: float = CHORDAL_TOL_MM,
+    extra: dict | None = None,
+    progress=None,
+) -> dict:
+    """Mesh and write every part, the STEP assembly, params.toml and manifest.json; returns the
+    manifest. ``progress`` (optional) is called with each part name as it is meshed."""
+    folder = ensure_out_dir(folder)
+    names = [p.name for p in parts]
+    if len(set(names)) != len(names):
+        raise ValueError(f"part names must be unique: {names}")
+    exported: list[ExportedPart] = []
+    meshed: dict[int, tuple[TriMesh, float]] = {}  # copies share a solid: mesh it once
+    for part in parts:
+        if progress:
+            progress(part.name)
+        if id(part.solid) not in meshed:
+            meshed[id(part.solid)] = (mesh_shape(part.solid, tol_mm), float(part.solid.Volume()))
+        mesh, volume = meshed[id(part.solid)]
+        stl = folder / f"{part.name}.stl"
+        atomic_write_bytes(stl, stl_bytes(posed(mesh, part.pose), part.name))
+        exported.append(ExportedPart(part, mesh, stl, volume))
+    step = folder / f"{name}.step"
+    write_step(parts, step, name)
+    params_file = folder / "params.toml"
+    atomic_write_text(params_file, to_toml(params_data))
+
+    manifest = {
+        "gearcheck_version": __version__,
+        "mechanism": mechanism,
+        "name": name,
+        "units": "mm",
+        "chordal_tolerance_mm": tol_mm,
+        "step": {"file": step.name, "sha256": sha256(step)},
+        "params_file": {"file": params_file.name, "sha256": sha256(params_file)},
+        "parts": [
+            {
+                "name": e.part.name,
+                "material": e.part.material,
+                "brep_volume_mm3": e.brep_volume_mm3,
+                "mesh_volume_mm3": e.mesh.volume(),
+                "triangles": int(len(e.mesh.faces)),
+                "vertices": int(len(e.mesh.vertices)),
+                "tolerance_mm": e.mesh.tolerance_mm,
+                "measured_mesh_error_mm": e.mesh.sampled_error_mm,
+                "mesh_error_bound_mm": e.mesh.error_bound_mm,
+                "watertight": e.mesh.is_watertight(),
+                "winding_consistent": e.mesh.is_winding_consistent(),
+                "pose": np.asarray(e.part.pose).tolist(),
+                "motion": e.part.motion,
+                "stl": {"file": e.stl.name, "sha256": sha256(e.stl)},
+            }
+            for e in exported
+        ],
+        "params": params_data,
+    }
+    if extra:
+        manifest.update(extra)
+    atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
+    return manifest
+
