@@ -84,6 +84,25 @@ def build_parser() -> argparse.ArgumentParser:
     build.add_argument("--tol", type=float, default=None, metavar="MM",
                        help="absolute chordal tolerance of the STL meshes in mm (default 0.01)")
 
+    check = sub.add_parser(
+        "check",
+        help="build, mesh and sweep the mechanism; write report.html, summary.json, sweep.csv",
+        description="Build the CAD (as `build`), sweep the assembly through its motion with "
+        "python-fcl on the meshes (warm and cold for the differential, a full engagement cycle "
+        "for the track drive, towing and power modes for the steering), confirm each sweep's "
+        "worst pose on the exact B-rep, and write DIR/report.html (verdicts, paper vs model vs "
+        "geometry, plots), DIR/summary.json (numbers) and DIR/sweep.csv (one row per pose) beside "
+        "the CAD. Exit 0 when every verdict passes, 1 when one fails, 2 on bad input.",
+    )
+    check.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
+    check.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                       help="override one template value (repeatable)")
+    check.add_argument("--all", action="store_true", help="check every template in templates/ into OUT/NAME")
+    check.add_argument("--out", type=Path, default=None,
+                       help="output folder (default out/NAME; with --all, the parent folder, default out)")
+    check.add_argument("--tol", type=float, default=None, metavar="MM",
+                       help="absolute chordal tolerance of the meshes in mm (default 0.01)")
+
     demo = sub.add_parser("demo", help="every template in templates/: figures and CAD under --out (what `make demo` runs)")
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
     demo.add_argument("--templates", type=Path, default=TEMPLATE_DIR, help="folder of templates (default: templates)")
@@ -127,7 +146,73 @@ def cmd_demo(args) -> int:
     return 0
 
 
-def _build_one(loaded, folder: Path, tol_mm: float | None) -> dict:
+def _templates_or_one(args) -> list:
+    """The validated templates a build/check acts on: one, or --all (all validated first)."""
+    from gearcheck.mechanisms import load_template
+
+    _check_tol(args.tol)
+    if args.all == (args.template is not None):
+        raise ParamError(args.command, str(args.template), "give one TEMPLATE or --all, not both or neither")
+    if args.all:
+        return [load_template(t, args.overrides) for t in sorted(TEMPLATE_DIR.glob("*.toml"))]
+    return [load_template(args.template, args.overrides)]
+
+
+def _out_folder(args, loaded) -> Path:
+    if args.all:
+        return (args.out or Path("out")) / loaded.name
+    return args.out or Path("out") / loaded.name
+
+
+def _check_one(loaded, folder: Path, tol_mm: float | None) -> bool:
+    from tqdm import tqdm
+
+    from gearcheck.cad.confirm import exact_distance
+    from gearcheck.cad.export import sweep_bodies
+    from gearcheck.output import atomic_write_text
+    from gearcheck.report.files import summary_json, sweep_csv
+    from gearcheck.report.html import render
+
+    manifest, exported = _build_one(loaded, folder, tol_mm)
+    bodies = sweep_bodies(exported)
+    with tqdm(desc=f"sweeping {loaded.name}", unit="pose", file=sys.stderr, disable=not sys.stderr.isatty()) as bar:
+        result = loaded.check_module.run_check(loaded.params, bodies, progress=bar.update)
+    parts = {e.part.name: e.part for e in exported}
+    confirmations = {}
+    for worst in tqdm(result.worst_poses, desc="exact B-rep distance at worst poses", file=sys.stderr,
+                      disable=not sys.stderr.isatty()):
+        confirmations[worst.label] = {
+            "parts": f"{worst.part_a} / {worst.part_b}",
+            "mesh_mm": worst.mesh_distance_mm,
+            "brep_mm": exact_distance(parts, worst),
+            "bound_mm": bodies[worst.part_a].error_bound_mm + bodies[worst.part_b].error_bound_mm,
+        }
+    numeric = {k: {kk: vv for kk, vv in v.items() if kk != "parts"} for k, v in confirmations.items()}
+    atomic_write_text(folder / "summary.json", summary_json(result, numeric))
+    atomic_write_text(folder / "sweep.csv", sweep_csv(result))
+    build = {
+        "chordal_tolerance_mm": manifest["chordal_tolerance_mm"],
+        "triangles": sum(p["triangles"] for p in manifest["parts"]),
+        "parts": len(manifest["parts"]),
+    }
+    page = render(result, title=f"gearcheck: {loaded.name} ({loaded.mechanism})", template=str(loaded.path),
+                  build=build, confirmations=confirmations)
+    atomic_write_text(folder / "report.html", page)
+    verdict = "PASS" if result.passed else "FAIL"
+    print(f"{verdict} {loaded.name}: {sum(v.passed for v in result.verdicts)}/{len(result.verdicts)} verdicts; "
+          f"report {folder / 'report.html'}")
+    for v in result.verdicts:
+        print(f"  [{'pass' if v.passed else 'FAIL'}] {v.label}: {v.detail}")
+    return result.passed
+
+
+def cmd_check(args) -> int:
+    items = _templates_or_one(args)
+    passed = [_check_one(item, _out_folder(args, item), args.tol) for item in items]
+    return 0 if all(passed) else 1
+
+
+def _build_one(loaded, folder: Path, tol_mm: float | None):
     from tqdm import tqdm
 
     from gearcheck.cad.export import export_parts
@@ -137,13 +222,13 @@ def _build_one(loaded, folder: Path, tol_mm: float | None) -> dict:
     parts = loaded.parts_module.build_parts(loaded.params)
     with tqdm(total=len(parts), desc=f"meshing {loaded.name}", unit="part", file=sys.stderr,
               disable=not sys.stderr.isatty()) as bar:
-        manifest = export_parts(
+        manifest, exported = export_parts(
             parts, folder, name=loaded.name, mechanism=loaded.mechanism, params_data=loaded.data,
             tol_mm=tol_mm if tol_mm is not None else CHORDAL_TOL_MM,
             progress=lambda _name: bar.update(1),
         )
     print(f"wrote {folder}/ : {len(parts)} parts, {manifest['step']['file']}, manifest.json")
-    return manifest
+    return manifest, exported
 
 
 def _check_tol(tol: float | None) -> None:
@@ -152,24 +237,12 @@ def _check_tol(tol: float | None) -> None:
 
 
 def cmd_build(args) -> int:
-    from gearcheck.mechanisms import load_template
-
-    _check_tol(args.tol)
-    if args.all == (args.template is not None):
-        raise ParamError("build", str(args.template), "give one TEMPLATE or --all, not both or neither")
-    if args.all:
-        templates = sorted(TEMPLATE_DIR.glob("*.toml"))
-        loaded = [load_template(t, args.overrides) for t in templates]  # validate all first
-        root = args.out or Path("out")
-        for item in loaded:
-            _build_one(item, root / item.name, args.tol)
-        return 0
-    loaded = load_template(args.template, args.overrides)
-    _build_one(loaded, args.out or Path("out") / loaded.name, args.tol)
+    for item in _templates_or_one(args):
+        _build_one(item, _out_folder(args, item), args.tol)
     return 0
 
 
-COMMANDS = {"calc": cmd_calc, "build": cmd_build, "demo": cmd_demo}
+COMMANDS = {"calc": cmd_calc, "build": cmd_build, "check": cmd_check, "demo": cmd_demo}
 
 
 def main(argv: list[str] | None = None) -> int:

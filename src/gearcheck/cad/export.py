@@ -79,9 +79,10 @@ def export_parts(
     tol_mm: float = CHORDAL_TOL_MM,
     extra: dict | None = None,
     progress=None,
-) -> dict:
+) -> tuple[dict, list[ExportedPart]]:
     """Mesh and write every part, the STEP assembly, params.toml and manifest.json; returns the
-    manifest. ``progress`` (optional) is called with each part name as it is meshed."""
+    manifest and the exported parts (meshes in their own frames). ``progress`` (optional) is
+    called with each part name as it is meshed."""
     folder = ensure_out_dir(folder)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
@@ -134,5 +135,17 @@ def export_parts(
     if extra:
         manifest.update(extra)
     atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
-    return manifest
+    return manifest, exported
+
+
+def sweep_bodies(exported: list[ExportedPart]) -> dict:
+    """The exported parts as the sweep layer's :class:`~gearcheck.sweep.engine.Body` objects
+    (plain arrays: picklable, no CAD kernel needed to use them)."""
+    from gearcheck.sweep.engine import Body, MeshData
+
+    return {
+        e.part.name: Body(MeshData(e.part.name, e.mesh.vertices, e.mesh.faces), np.asarray(e.part.pose, float),
+                          e.mesh.error_bound_mm, e.part.material, dict(e.part.motion))
+        for e in exported
+    }
 

@@ -47,6 +47,11 @@ class Loaded:
         return importlib.import_module(MECHANISMS[self.mechanism] + ".parts")
 
     @property
+    def check_module(self) -> ModuleType:
+        """``run_check(params, bodies, progress) -> CheckResult``: FCL sweeps, no CadQuery."""
+        return importlib.import_module(MECHANISMS[self.mechanism] + ".check")
+
+    @property
     def name(self) -> str:
         return self.path.stem
 

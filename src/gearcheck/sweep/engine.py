@@ -26,6 +26,30 @@ class MeshData:
     faces: np.ndarray
 
 
+@dataclass(frozen=True)
+class Body:
+    """A part as the sweep sees it: its mesh in its own frame, its pose as built (frame → world),
+    the mesh-error bound measured when it was meshed, its material and how it may move."""
+
+    mesh: MeshData
+    pose: np.ndarray
+    error_bound_mm: float
+    material: str = ""
+    motion: dict | None = None
+
+    @property
+    def name(self) -> str:
+        return self.mesh.name
+
+    def scaled(self, factor: float, datum_local: np.ndarray | None = None) -> "Body":
+        """The part shrunk or grown by ``factor`` about a datum point of its own frame (a thermal
+        state: each part by its own material, never the whole assembly by one factor)."""
+        datum = np.zeros(3) if datum_local is None else np.asarray(datum_local, float)
+        v = datum + (self.mesh.vertices - datum) * factor
+        return Body(MeshData(self.mesh.name, v, self.mesh.faces), self.pose, self.error_bound_mm * factor,
+                    self.material, self.motion)
+
+
 def _bvh(mesh: MeshData) -> fcl.BVHModel:
     model = fcl.BVHModel()
     model.beginModel(len(mesh.vertices), len(mesh.faces))

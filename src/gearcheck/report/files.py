@@ -1,0 +1,61 @@
+"""summary.json and sweep.csv: deterministic (same inputs → byte-identical files)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import math
+
+from gearcheck.sweep.result import CheckResult
+
+
+def _plain(value):
+    """JSON-safe plain value: bools as 1/0, non-finite floats as null, numpy scalars as floats."""
+    if isinstance(value, dict):
+        return {str(k): _plain(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_plain(v) for v in value]
+    if isinstance(value, bool):
+        return int(value)
+    if hasattr(value, "item") and not isinstance(value, (str, bytes)):
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
+
+
+def summary_json(result: CheckResult, confirmations: dict | None = None) -> str:
+    """``{section: {...summary..., "verdicts": {key: 1/0}, "verdict_pass": 1/0,
+    "exact_confirmation": {label: {...}}}}`` with sorted keys."""
+    body = dict(result.summary)
+    body["verdicts"] = {v.key: int(v.passed) for v in result.verdicts}
+    body["verdict_pass"] = int(result.passed)
+    if confirmations:
+        body["exact_confirmation"] = confirmations
+    return json.dumps({result.section: _plain(body)}, indent=2, sort_keys=True, allow_nan=False) + "\n"
+
+
+def _cell(value) -> str:
+    if isinstance(value, bool):
+        return str(int(value))
+    if isinstance(value, float):
+        return "" if not math.isfinite(value) else f"{value:.9g}"
+    if hasattr(value, "item"):
+        return _cell(value.item())
+    return str(value)
+
+
+def sweep_csv(result: CheckResult) -> str:
+    """One row per pose; columns in order of first appearance across rows."""
+    columns: list[str] = []
+    for row in result.rows:
+        for key in row:
+            if key not in columns:
+                columns.append(key)
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(columns)
+    for row in result.rows:
+        writer.writerow([_cell(row.get(c, "")) for c in columns])
+    return out.getvalue()
