@@ -185,9 +185,10 @@ def _check_one(loaded, folder: Path, tol_mm: float | None) -> bool:
             "parts": f"{worst.part_a} / {worst.part_b}",
             "mesh_mm": worst.mesh_distance_mm,
             "brep_mm": exact_distance(parts, worst),
-            "bound_mm": bodies[worst.part_a].error_bound_mm + bodies[worst.part_b].error_bound_mm,
+            "bound_mm": sum(bodies[n.partition(".")[0]].error_bound_mm for n in (worst.part_a, worst.part_b)),
         }
-    numeric = {k: {kk: vv for kk, vv in v.items() if kk != "parts"} for k, v in confirmations.items()}
+    keys = {w.label: w.json_key for w in result.worst_poses}
+    numeric = {keys[k]: {kk: vv for kk, vv in v.items() if kk != "parts"} for k, v in confirmations.items()}
     atomic_write_text(folder / "summary.json", summary_json(result, numeric))
     atomic_write_text(folder / "sweep.csv", sweep_csv(result))
     build = {

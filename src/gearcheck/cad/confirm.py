@@ -13,14 +13,18 @@ from gearcheck.cad.placement import Part, place
 from gearcheck.sweep.result import WorstPose
 
 
-def _posed(part: Part, pose, scale: float):
-    solid = part.solid if scale == 1.0 else part.solid.scale(scale)  # about the own-frame origin
+def _posed(parts: dict[str, Part], name: str, pose, scale: float):
+    """``name`` is a part ("link_03") or one of its features ("link_03.plate")."""
+    base, _, feature = name.partition(".")
+    solid = parts[base].feature(feature)
+    if scale != 1.0:
+        solid = solid.scale(scale)  # about the own-frame origin
     return place(solid, np.asarray(pose, float))
 
 
 def exact_distance(parts: dict[str, Part], worst: WorstPose) -> float:
-    a = _posed(parts[worst.part_a], worst.pose_a, worst.scale_a)
-    b = _posed(parts[worst.part_b], worst.pose_b, worst.scale_b)
+    a = _posed(parts, worst.part_a, worst.pose_a, worst.scale_a)
+    b = _posed(parts, worst.part_b, worst.pose_b, worst.scale_b)
     dist = BRepExtrema_DistShapeShape(a.wrapped, b.wrapped)
     if not dist.IsDone():
         raise RuntimeError(f"BRepExtrema failed at {worst.label}")

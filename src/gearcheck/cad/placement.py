@@ -41,6 +41,13 @@ class Part:
     color: tuple[float, float, float] = (0.7, 0.7, 0.75)
     # how the sweep may move it, e.g. {"kind": "rotation", "axis": [...], "origin": [...]}
     motion: dict = field(default_factory=dict)
+    # named sub-solids in the same frame (a link's "plate" and "sleeve"), so a check can confirm
+    # a distance to one feature ("link_03.plate") on the exact B-rep
+    features: dict = field(default_factory=dict)
+
+    def feature(self, name: str) -> cq.Shape:
+        """The whole solid (name "") or one named feature, in the part's own frame."""
+        return self.solid if not name else self.features[name]
 
     def placed(self) -> cq.Shape:
         """The solid in the world frame (shares its geometry)."""

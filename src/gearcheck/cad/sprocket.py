@@ -25,21 +25,22 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeWire
 from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
 from gearcheck.cad.placement import Part, place
+# The layout (numbers) lives in the mechanism's pure module, which the template model also
+# builds to reject a set before any CAD work; re-exported here for the CAD callers.
+from gearcheck.mechanisms.track.layout import (  # noqa: F401
+    BORE_DIAMETER_MM,
+    DEFAULT_ENTRY_ANGLE_DEG,
+    DEFAULT_RUN_LINKS,
+    DEFAULT_WRAP_ANGLE_DEG,
+    MIDDLE_GROOVE_DEPTH_MM,
+    SprocketSpec,
+    default_wrap,
+    link_geometry,
+    sprocket_spec,
+)
 
 SPROCKET_MATERIAL = "7075-T651 aluminium alloy"
 LINK_MATERIAL = "cast aluminium track link with steel sleeve"
-
-# Depth of the middle (guide-lug) groove's floor below the root circle r = d/2 − ri. The paper's
-# Fig. 8 is lost; 6 mm leaves the track's guide lugs room to hang 6 mm below the seating bottom.
-MIDDLE_GROOVE_DEPTH_MM = 6.0
-# Shaft bore (not given by the paper; ~27 N·m per sprocket needs far less than 25 mm of steel).
-BORE_DIAMETER_MM = 25.0
-# The default segment and its wrap (see track_chain.ChainWrap): upper run horizontal, arriving
-# from +x at the top, 120° of wrap, lower run leaving 30° below horizontal towards +x (a raised
-# drive sprocket); the links the wrap seats plus 2 on each run (z = 49: 12 links, 8 seated at θ = 0).
-DEFAULT_RUN_LINKS = 2
-DEFAULT_ENTRY_ANGLE_DEG = 90.0
-DEFAULT_WRAP_ANGLE_DEG = 120.0
 
 
 def _v(p: np.ndarray, z: float) -> cq.Vector:
@@ -90,40 +91,6 @@ def row_outline_wire(gap: iso606.ToothGap, z: float) -> cq.Wire:
     if not maker.IsDone():
         raise RuntimeError("sprocket outline does not close into a wire")
     return cq.Wire(maker.Wire())
-
-
-@dataclass(frozen=True)
-class SprocketSpec:
-    """Everything the sprocket solid needs (mm)."""
-
-    gap: iso606.ToothGap
-    tooth_width_mm: float
-    tooth_rows: int
-    middle_groove_width_mm: float
-    hub_radius_mm: float
-    bore_radius_mm: float
-
-    def row_z_ranges(self) -> list[tuple[float, float]]:
-        """(z_low, z_high) of each tooth row, symmetric about z = 0."""
-        pitch = self.tooth_width_mm + self.middle_groove_width_mm
-        total = self.tooth_rows * self.tooth_width_mm + (self.tooth_rows - 1) * self.middle_groove_width_mm
-        return [(-total / 2 + i * pitch, -total / 2 + i * pitch + self.tooth_width_mm)
-                for i in range(self.tooth_rows)]
-
-
-def sprocket_spec(params, middle_groove_depth_mm: float = MIDDLE_GROOVE_DEPTH_MM,
-                  bore_diameter_mm: float = BORE_DIAMETER_MM) -> SprocketSpec:
-    """The template's sprocket: eq. 6–8 diameters and the chosen ISO 606 form."""
-    sp, ch = params.sprocket, params.chain
-    d = iso606.every_other_tooth_pitch_diameter(ch.pitch_mm, sp.teeth)
-    gap = iso606.tooth_gap(d, sp.teeth, sp.seating_radius_mm, sp.flank_radius_mm, sp.seating_angle_deg,
-                           d + sp.tip_over_pitch_mm)
-    root_radius = gap.pitch_radius_mm - gap.seating_radius_mm
-    hub = root_radius - middle_groove_depth_mm
-    if not bore_diameter_mm / 2.0 < hub:
-        raise ValueError("bore larger than the middle groove's floor")
-    return SprocketSpec(gap, sp.tooth_width_mm, sp.tooth_rows, sp.middle_groove_width_mm, hub,
-                        bore_diameter_mm / 2.0)
 
 
 def build_sprocket(spec: SprocketSpec) -> cq.Solid:
@@ -205,21 +172,19 @@ def track_drive_parts(params, sprocket_angle_rad: float = 0.0, links: int | None
     The plate offset e comes from the mechanism analysis (the offset that leaves the template's
     tip gap under a seated link's plate); the solids are built once and shared by every link.
     """
-    from gearcheck.mechanisms.track import analysis  # the analysis owns e = gap + tip − pin line
-
     t0 = time.perf_counter()
     spec = sprocket_spec(params)
     sprocket = build_sprocket(spec)
     t1 = time.perf_counter()
-    ch = params.chain
-    e = analysis.plate_offset_for_tip_gap(spec.gap, params.track_plate.tip_gap_mm)
-    geo = tc.link_geometry(ch.pitch_mm, ch.sleeve_diameter_mm, e, ch.track_width_mm)
+    geo = link_geometry(params, spec.gap)
     link_solids = build_link(geo)
     t2 = time.perf_counter()
-    wrap = tc.ChainWrap.centred(params.sprocket.teeth, ch.pitch_mm, links, entry_angle_deg, wrap_angle_deg,
-                                run_links)
+    wrap = default_wrap(params.sprocket.teeth, params.chain.pitch_mm, links, entry_angle_deg, wrap_angle_deg,
+                        run_links)
     poses = wrap.link_matrices(sprocket_angle_rad)
-    link_parts = [Part(f"link_{j:02d}", LINK_MATERIAL, link_solids.link, poses[j], color=(0.3, 0.3, 0.35), motion={"kind": "chain_link"}) for j in range(wrap.links)]
+    features = {"plate": link_solids.plate, "sleeve": link_solids.sleeve}
+    link_parts = [Part(f"link_{j:02d}", LINK_MATERIAL, link_solids.link, poses[j], color=(0.3, 0.3, 0.35),
+                       motion={"kind": "chain_link"}, features=features) for j in range(wrap.links)]
     return TrackDriveParts(
         sprocket_angle_rad=sprocket_angle_rad,
         sprocket_spec=spec,

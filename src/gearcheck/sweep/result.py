@@ -66,6 +66,14 @@ class WorstPose:
     mesh_distance_mm: float
     scale_a: float = 1.0
     scale_b: float = 1.0
+    key: str = ""  # JSON key in summary.json; default: made from the label
+
+    @property
+    def json_key(self) -> str:
+        if self.key:
+            return self.key
+        slug = "".join(c if c.isascii() and c.isalnum() else "_" for c in self.label.lower())
+        return "_".join(filter(None, slug.split("_")))[:80]
 
 
 @dataclass
@@ -80,6 +88,9 @@ class CheckResult:
     plots: list[Plot] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)  # findings in words, for the report
     worst_poses: list[WorstPose] = field(default_factory=list)
+    # wall-clock figures (s, poses/s): for benchmarks and the terminal, never in summary.json,
+    # which must be byte-identical between runs
+    timings: dict = field(default_factory=dict)
 
     @property
     def passed(self) -> bool:

@@ -1,0 +1,210 @@
+"""Track drive sweep (issue 10): tooth–sleeve clearance, seated tip gap and tip-to-plate distance
+over an engagement cycle, on the generated meshes (cad) and in the exact 2-D model (numpy)."""
+
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from gearcheck.geometry import track_chain as tc
+from gearcheck.mechanisms import load_template
+from gearcheck.mechanisms.track import check
+from gearcheck.sweep.engine import Body, MeshData, Scene
+
+TEMPLATE = "eod_track_drive"
+# Reduced sampling for the tests: 24 steps per cycle (β/24 = 0.61°) still covers the cycle plus
+# margins and every link passes in, seated and out; the default (60) only refines the curves.
+TEST_STEPS = 24
+
+
+@pytest.fixture(scope="module")
+def model(templates_dir):
+    return check.track_model(load_template(templates_dir / f"{TEMPLATE}.toml").params)
+
+
+@pytest.fixture(scope="module")
+def exact(model):
+    return check.ExactSection(model)
+
+
+def seated_link(model, angle=0.0):
+    return int(np.flatnonzero(model.wrap.seated_links(angle))[3])
+
+
+# --- exact 2-D model and pose data (no CAD) ----------------------------------------------------
+
+
+def test_exact_model_seated_values_match_the_closed_forms(model, exact):
+    """A seated sleeve is concentric with its seat (ri − R) and the plate face lies the template gap
+    above the tip corner (e from the closed form in analysis): the polyline model measures both,
+    within its chord sagitta."""
+    j = seated_link(model)
+    sleeve, plate = exact.link_distances(tc.sprocket_matrix(0.0), model.wrap.link_matrices(0.0)[j])
+    assert sleeve == pytest.approx(model.seating_clearance_mm, abs=exact.sagitta_mm + 1e-9)
+    assert plate == pytest.approx(model.tip_gap_mm, abs=exact.sagitta_mm + 1e-9)
+    assert exact.sagitta_mm < 1e-4
+
+
+def test_exact_model_contact_from_both_sides(model, exact):
+    """The plate pushed towards the axis by the gap ∓ 0.01 mm clears / enters the tooth."""
+    j = seated_link(model)
+    pose = model.wrap.link_matrices(0.0)[j]
+    s = tc.sprocket_matrix(0.0)
+
+    def pushed(by):
+        moved = pose.copy()
+        moved[:3, 3] -= by * pose[:3, 1]
+        return exact.link_distances(s, moved)[1]
+
+    assert pushed(model.tip_gap_mm - 0.01) == pytest.approx(0.01, abs=1e-6)
+    assert pushed(model.tip_gap_mm + 0.01) < 0.0
+
+
+def test_exact_model_repeats_after_one_cycle(model, exact):
+    """After β every pose repeats shifted by one pin (and two grooves): per-link distances agree."""
+    beta = model.wrap.cycle_rad
+    for angle in (0.1 * beta, 0.55 * beta):
+        now = [exact.link_distances(tc.sprocket_matrix(angle), m) for m in model.wrap.link_matrices(angle)]
+        later = [exact.link_distances(tc.sprocket_matrix(angle + beta), m)
+                 for m in model.wrap.link_matrices(angle + beta)]
+        for j in range(2, model.wrap.links - 1):  # link j + 1 later is where link j was
+            assert later[j] == pytest.approx(now[j - 1], abs=1e-9)
+
+
+def test_plate_boundary_leaves_out_the_part_inside_the_sleeve(model):
+    geo = model.link
+    segments = check.plate_boundary(geo)
+    r, e = geo.sleeve_radius_mm, geo.plate_offset_mm
+    for a, b in segments:
+        for t in np.linspace(0, 1, 11):
+            assert np.hypot(*(a + t * (b - a))) >= r - 1e-9
+    bottom = [(a, b) for a, b in segments if abs(a[1] - e) < 1e-12 and abs(b[1] - e) < 1e-12]
+    assert len(bottom) == 1
+    assert min(bottom[0][0][0], bottom[0][1][0]) == pytest.approx(math.sqrt(r * r - e * e), abs=1e-9)
+
+
+def test_sweep_angles_cover_a_cycle_with_margins(model):
+    beta = model.wrap.cycle_rad
+    angles = check.sweep_angles(model.wrap, 60, 0.125)
+    assert angles[0] < 0.0 and angles[-1] > beta
+    assert np.isclose(angles, 0.0).any() and np.isclose(angles, beta).any()
+    covered = (angles[-1] - angles[0]) / beta  # margins rounded up to whole steps
+    assert 1.25 <= covered <= 1.25 + 2.0 / 60 + 1e-12
+
+
+def test_check_module_does_not_import_cadquery():
+    code = ("import sys, gearcheck.mechanisms.track.check; "
+            "sys.exit(any(m.split('.')[0] in ('cadquery', 'OCP') for m in sys.modules))")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+# --- the sweep on the generated meshes ----------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def template_run(build_bodies):
+    loaded, _, bodies = build_bodies(TEMPLATE)
+    counted = []
+    result = check.run_check(loaded.params, bodies, counted.append, steps_per_cycle=TEST_STEPS, workers=1)
+    return loaded, bodies, result, sum(counted)
+
+
+@pytest.mark.cad
+def test_template_sweep_verdicts_and_figures(template_run):
+    loaded, bodies, result, progressed = template_run
+    s = result.summary
+    bound = s["mesh_error_bound_mm"]
+    assert result.passed and s["verdict_pass"] == 1, [v for v in result.verdicts if not v.passed]
+    assert {v.key for v in result.verdicts} >= {"no_interference", "seated_tip_gap_in_window",
+                                                 "min_tip_plate_distance"}
+    # coverage: at least one whole cycle, every pose counted by the progress callback
+    assert s["cycles_covered"] >= 1.0
+    assert s["poses"] == len(result.rows) == progressed
+    assert s["cycle_deg"] == pytest.approx(720.0 / loaded.params.sprocket.teeth)
+    # no interference anywhere; the seated sleeve's clearance ri − R is resolved beyond the bound
+    assert s["collisions"] == 0 and not any(r["collide"] for r in result.rows)
+    assert s["min_tooth_sleeve_clearance_mm"] > bound
+    assert s["seated_sleeve_clearance_mm"] == pytest.approx(s["model_seating_clearance_mm"], abs=bound)
+    # the seated gap is the template's 0.75 mm (mesh: a plane against exact tip-corner vertices)
+    assert s["seated_tip_gap_mm"] == pytest.approx(0.75, abs=bound)
+    assert s["seated_tip_gap_max_mm"] == pytest.approx(0.75, abs=bound)
+    assert s["min_tip_plate_distance_mm"] >= 0.5
+    assert s["min_tip_plate_distance_mm"] == pytest.approx(s["seated_tip_gap_mm"], abs=1e-9)
+    assert s["min_at_seated_links"] == 1
+    # contact from both sides: free at gap − tol, touching at gap + tol, bracket = measured gap
+    c = s["contact"]
+    assert c["tip_gap_free_at_minus_tol"] == c["tip_gap_touching_at_plus_tol"] == 1
+    assert c["tip_gap_free_mm"] <= s["seated_tip_gap_mm"] + 1e-9 <= c["tip_gap_touching_mm"] + 2e-9
+    assert (c["tip_gap_free_mm"] + c["tip_gap_touching_mm"]) / 2 == pytest.approx(s["seated_tip_gap_mm"], abs=bound)
+    assert c["seat_free_at_minus_tol"] == c["seat_touching_at_plus_tol"] == 1
+    assert (c["seat_free_mm"] + c["seat_touching_mm"]) / 2 == pytest.approx(
+        s["min_tooth_sleeve_clearance_mm"], abs=bound)
+    # mesh and exact 2-D model agree at every pose and link
+    assert s["exact"]["max_mesh_deviation_mm"] <= bound
+    for row in result.rows:
+        assert row["min_tip_plate_distance_mm"] == pytest.approx(row["exact_min_tip_plate_mm"], abs=bound)
+        assert row["min_tooth_sleeve_clearance_mm"] == pytest.approx(row["exact_min_tooth_sleeve_mm"], abs=bound)
+    # report data: flat rows with the same keys, worst poses for exact confirmation
+    keys = set(result.rows[0])
+    assert {"angle_deg", "min_tooth_sleeve_clearance_mm", "min_tip_plate_distance_mm", "seated_links",
+            "collide"} <= keys and all(set(r) == keys for r in result.rows)
+    assert {r["seated_links"] for r in result.rows} <= {8, 9}
+    assert len(result.worst_poses) == 2 and result.plots[0].hlines[0][1] == 0.5
+
+
+@pytest.mark.cad
+def test_worst_poses_are_the_reported_minima(template_run):
+    """Re-measure the worst poses from their own data (poses as data, nothing else shared)."""
+    loaded, bodies, result, _ = template_run
+    link = next(b for n, b in bodies.items() if n.startswith("link_"))
+    _, plate = check.split_link_mesh(link.mesh, loaded.params.chain.sleeve_diameter_mm / 2.0)
+    scene = Scene([bodies["sprocket"].mesh, plate, MeshData("whole", link.mesh.vertices, link.mesh.faces)])
+    sleeve_pose, plate_pose = result.worst_poses
+    assert sleeve_pose.part_b in bodies and plate_pose.part_b.endswith(".plate")
+    scene.set_pose("sprocket", np.array(sleeve_pose.pose_a))
+    scene.set_pose("whole", np.array(sleeve_pose.pose_b))
+    assert scene.distance("sprocket", "whole").distance == pytest.approx(sleeve_pose.mesh_distance_mm, abs=1e-9)
+    scene.set_pose("sprocket", np.array(plate_pose.pose_a))
+    scene.set_pose("plate", np.array(plate_pose.pose_b))
+    assert scene.distance("sprocket", "plate").distance == pytest.approx(
+        result.summary["min_tip_plate_distance_mm"], abs=1e-9)
+
+
+@pytest.mark.cad
+def test_bodies_from_another_wrap_are_refused(template_run):
+    loaded, bodies, _, _ = template_run
+    moved = dict(bodies)
+    name = "link_03"
+    b = bodies[name]
+    moved[name] = Body(b.mesh, b.pose @ tc.planar_matrix(0.0, 0.0, 0.01), b.error_bound_mm)
+    with pytest.raises(ValueError, match="wrap"):
+        check.run_check(loaded.params, moved, steps_per_cycle=2, workers=1)
+
+
+@pytest.mark.cad
+def test_seated_gap_follows_the_template_gap(build_bodies):
+    """--set track_plate.tip_gap_mm=0.5 moves the plate face: the measured seated gap follows, the
+    contact bracket with it, and 0.5 mm is still inside the paper's window."""
+    loaded, _, bodies = build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.5",))
+    result = check.run_check(loaded.params, bodies, steps_per_cycle=12, workers=2)
+    s = result.summary
+    bound = s["mesh_error_bound_mm"]
+    assert s["seated_tip_gap_mm"] == pytest.approx(0.5, abs=bound)
+    assert s["min_tip_plate_distance_mm"] == pytest.approx(0.5, abs=bound)
+    c = s["contact"]
+    assert (c["tip_gap_free_mm"] + c["tip_gap_touching_mm"]) / 2 == pytest.approx(s["seated_tip_gap_mm"], abs=bound)
+    assert s["collisions"] == 0 and result.passed
+
+
+@pytest.mark.cad
+def test_a_gap_below_the_window_fails(build_bodies):
+    """A plate 0.3 mm over the tips: measured as such, the window verdicts fail, the rest hold."""
+    loaded, _, bodies = build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.3",))
+    result = check.run_check(loaded.params, bodies, steps_per_cycle=4, workers=1)
+    verdicts = {v.key: v.passed for v in result.verdicts}
+    assert result.summary["seated_tip_gap_mm"] == pytest.approx(0.3, abs=result.summary["mesh_error_bound_mm"])
+    assert not verdicts["seated_tip_gap_in_window"] and not verdicts["min_tip_plate_distance"]
+    assert verdicts["no_interference"] and verdicts["contact_proven"] and not result.passed
+    assert result.summary["verdict_pass"] == 0
