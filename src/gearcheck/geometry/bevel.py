@@ -444,7 +444,7 @@ def section_profile(spec: BevelGearSpec, z_plane: float, flank_points: int = 24,
 
 
 # -- exact distance from the flank surface ----------------------------------------------
-def _minus_flank_signed(spec: BevelGearSpec, p: np.ndarray) -> np.ndarray:
+def minus_flank_signed(spec: BevelGearSpec, p: np.ndarray) -> np.ndarray:
     """Signed distance (mm, + outside the tooth) of points p (N, 3) from tooth 0's −flank,
     extended: the cone over the whole involute for θ ≥ δb, the meridian half-plane below.
 
@@ -491,7 +491,7 @@ def flank_distance(spec: BevelGearSpec, points, side: int | None = None,
         q = np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1], p[:, 2]], -1)
         for sd in sides:
             qq = q if sd == -1 else q * np.array([1.0, -1.0, 1.0])
-            d = _minus_flank_signed(spec, qq)
+            d = minus_flank_signed(spec, qq)
             best = np.where(np.abs(d) < np.abs(best), d, best)
     return best if signed else np.abs(best)
 
