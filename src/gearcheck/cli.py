@@ -123,7 +123,8 @@ def cmd_calc(args) -> int:
 
 
 def cmd_demo(args) -> int:
-    """Every template: the analytical figures (calc.json, calc.txt) and the CAD (build)."""
+    """Every template: the analytical figures (calc.json, calc.txt), then `check` (CAD, sweep,
+    report) unless --no-cad. Exit 1 if any verdict fails, after every template has run."""
     from gearcheck.mechanisms import load_template
     from gearcheck.output import atomic_write_text, ensure_out_dir
 
@@ -131,6 +132,7 @@ def cmd_demo(args) -> int:
     if not templates:
         raise ParamError("--templates", str(args.templates), "no *.toml templates found there")
     loaded = [load_template(path) for path in templates]  # validate every template first
+    passed = []
     for item in loaded:
         figures = item.module.calc(item.params)
         folder = ensure_out_dir(args.out / item.name)
@@ -140,10 +142,10 @@ def cmd_demo(args) -> int:
         print(table)
         print()
         if not args.no_cad:
-            _build_one(item, folder, None)
+            passed.append(_check_one(item, folder, None))
             print()
-    print(f"wrote {len(loaded)} result folders under {args.out}/")
-    return 0
+    print(f"wrote {len(loaded)} result folders under {args.out}/ (open NAME/report.html)")
+    return 0 if all(passed) else 1
 
 
 def _templates_or_one(args) -> list:
