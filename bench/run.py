@@ -66,6 +66,45 @@ def bench_build(repeat: int) -> dict:
     }
 
 
+def bench_sweeps(repeat: int) -> dict:
+    """Each mechanism's sweep on 0.01 mm meshes: wall time (median) and the speed figures the
+    check reports (poses/s, ms per play measurement...) from the median run."""
+    import tempfile
+
+    from gearcheck.cad.export import export_parts, sweep_bodies
+
+    out = {}
+    for path in TEMPLATES:
+        loaded = load_template(path)
+        parts = loaded.parts_module.build_parts(loaded.params)
+        with tempfile.TemporaryDirectory() as tmp:
+            _, exported = export_parts(parts, Path(tmp), name=loaded.name, mechanism=loaded.mechanism,
+                                       params_data=loaded.data)
+        bodies = sweep_bodies(exported)
+        runs = []
+        for _ in range(repeat):
+            t0 = time.perf_counter()
+            result = loaded.check_module.run_check(loaded.params, bodies)
+            runs.append((time.perf_counter() - t0, result.timings))
+        runs.sort(key=lambda r: r[0])
+        wall, timings = runs[len(runs) // 2]
+        out[path.stem] = {"median_s": wall, "runs_s": [r[0] for r in runs], "figures_of_median_run": timings}
+    return out
+
+
+def bench_check_all(repeat: int) -> dict:
+    """`gearcheck check --all` wall time in a fresh process (build, mesh, sweep, B-rep, report)."""
+    import subprocess
+    import tempfile
+
+    def run():
+        with tempfile.TemporaryDirectory() as tmp:
+            subprocess.run([sys.executable, "-m", "gearcheck", "check", "--all", "--out", tmp],
+                           cwd=ROOT, check=True, capture_output=True)
+
+    return median_time(run, repeat)
+
+
 def bench_build_all(repeat: int) -> dict:
     """`gearcheck build --all` wall time in a fresh process (includes import cadquery)."""
     import subprocess
@@ -83,6 +122,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench.json")
     ap.add_argument("--repeat", type=int, default=5)
+    ap.add_argument("--repeat-sweep", type=int, default=3, help="runs of each sweep and of check --all")
     args = ap.parse_args()
     ensure_out_dir(args.out.parent)
     result = {
@@ -93,12 +133,17 @@ def main() -> int:
         "calc": bench_calc(args.repeat),
         "build": bench_build(3),
         "build_all_wall": bench_build_all(3),
+        "sweep": bench_sweeps(args.repeat_sweep),
+        "check_all_wall": bench_check_all(args.repeat_sweep),
     }
     atomic_write_text(args.out, json.dumps(result, indent=2) + "\n")
     for group in ("calc", "build"):
         for name, fig in result[group].items():
             print(f"{group:5s} {name:28s} median {fig['median_s'] * 1e3:8.1f} ms")
     print(f"build --all (fresh process)         median {result['build_all_wall']['median_s']:8.2f} s")
+    for name, fig in result["sweep"].items():
+        print(f"sweep {name:28s} median {fig['median_s']:8.2f} s  {fig['figures_of_median_run']}")
+    print(f"check --all (fresh process)         median {result['check_all_wall']['median_s']:8.2f} s")
     print(f"wrote {args.out}")
     return 0
 

@@ -351,8 +351,9 @@ def run_check(params, bodies: dict[str, Body], progress: Callable[[int], None] |
              "exact_s": sum(r["exact_s"] for r in results), "period_rad": period}
     result = _assemble(params, specs, bodies, thermal_at, shims, template_shim, angles, by_key, bound_arcmin,
                        bound_max_mm, speed, meshes)
+    result.timings.update(_timings(by_key, results, speed))
     if timings is not None:
-        timings.update(_timings(by_key, results, speed))
+        timings.update(result.timings)
     return result
 
 
