@@ -132,10 +132,10 @@ def cmd_demo(args) -> int:
     if not templates:
         raise ParamError("--templates", str(args.templates), "no *.toml templates found there")
     loaded = [load_template(path) for path in templates]  # validate every template first
+    folders = [ensure_out_dir(args.out / item.name) for item in loaded]
     passed = []
-    for item in loaded:
+    for item, folder in zip(loaded, folders):
         figures = item.module.calc(item.params)
-        folder = ensure_out_dir(args.out / item.name)
         atomic_write_text(folder / "calc.json", json.dumps(figures_to_json(item.module.SECTION, figures), indent=2, allow_nan=False) + "\n")
         table = render_table(f"{item.name} ({item.mechanism}) — analytical model", figures)
         atomic_write_text(folder / "calc.txt", table + "\n")
@@ -226,9 +226,17 @@ def _mesh_nearest_midpoint(bodies, worst):
     return 0.5 * (d.point_a + d.point_b)
 
 
+def _prepared_folders(args, items) -> list[Path]:
+    """Every output folder checked (created, writable) before any CAD work starts."""
+    from gearcheck.output import ensure_out_dir
+
+    return [ensure_out_dir(_out_folder(args, item)) for item in items]
+
+
 def cmd_check(args) -> int:
     items = _templates_or_one(args)
-    passed = [_check_one(item, _out_folder(args, item), args.tol) for item in items]
+    folders = _prepared_folders(args, items)
+    passed = [_check_one(item, folder, args.tol) for item, folder in zip(items, folders)]
     return 0 if all(passed) else 1
 
 
@@ -257,8 +265,9 @@ def _check_tol(tol: float | None) -> None:
 
 
 def cmd_build(args) -> int:
-    for item in _templates_or_one(args):
-        _build_one(item, _out_folder(args, item), args.tol)
+    items = _templates_or_one(args)
+    for item, folder in zip(items, _prepared_folders(args, items)):
+        _build_one(item, folder, args.tol)
     return 0
 
 

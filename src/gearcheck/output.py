@@ -20,6 +20,14 @@ def ensure_out_dir(folder: Path) -> Path:
         raise ParamError("--out", str(folder), f"cannot create folder: {exc.strerror}") from None
     if not os.access(folder, os.W_OK):
         raise ParamError("--out", str(folder), "folder is not writable")
+    # os.access says yes to root even where no file can be made (/proc, /sys, read-only mounts):
+    # try the real thing, the way every output file is written (a temporary file beside it).
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".gearcheck-write-test.", suffix=".part", dir=folder)
+    except OSError as exc:
+        raise ParamError("--out", str(folder), f"folder is not writable (cannot create a file there: {exc.strerror})") from None
+    os.close(fd)
+    os.unlink(probe)
     return folder
 
 

@@ -30,14 +30,10 @@ from OCP.BRepCheck import BRepCheck_Analyzer
 from gearcheck.geometry import rack_pinion as rp
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
 from gearcheck.cad.placement import Part
+# Face width and pinion bore (not in the paper) live with the mechanism, whose template model
+# checks that the bore fits before any CAD work; re-exported here.
+from gearcheck.mechanisms.steering.layout import FACE_WIDTH_MM, PINION_BORE_DIAMETER_MM, bore_fits
 
-# Face width of pinion and rack (not in the paper): b = 7.5·m, a usual 6–10·m for a through-
-# hardened steel rack drive; it changes no kinematic figure. A template input if strength is ever
-# checked.
-FACE_WIDTH_MM = 30.0
-# Pinion bore (not in the paper; the pinion sits on the steering collar). It must stay inside
-# the root circle (79 mm), where nothing meets the rack.
-PINION_BORE_DIAMETER_MM = 60.0
 # Exact points interpolated per involute flank (uniform in roll angle). Measured on the built
 # solid against the closed-form involute (docs/rack_pinion_cad.md): 8 → 0.047 µm, 12 → 0.008 µm,
 # 24 → 0.0005 µm; far inside the 1 µm the zero-backlash sweep needs.
@@ -99,7 +95,7 @@ def build_pinion(g: RackPinionGeometry, face_width_mm: float = FACE_WIDTH_MM,
                  bore_diameter_mm: float = PINION_BORE_DIAMETER_MM,
                  flank_points: int = FLANK_SPLINE_POINTS) -> cq.Solid:
     """The pinion solid in its own frame, z from −b/2 to b/2."""
-    if not bore_diameter_mm / 2.0 < g.root_radius:
+    if not bore_fits(g.root_radius, bore_diameter_mm):
         raise ValueError("pinion bore reaches the root circle")
     z0 = -face_width_mm / 2.0
     outer = pinion_outline_wire(g, z0, flank_points)

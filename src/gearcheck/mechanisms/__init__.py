@@ -66,7 +66,7 @@ def load_template(path: str | Path, overrides: list[str] | None = None) -> Loade
     except ParamError as exc:
         raise exc.with_source(source) from None
     mech = data.get("mechanism")
-    if mech not in MECHANISMS:
+    if not isinstance(mech, str) or mech not in MECHANISMS:
         raise ParamError("mechanism", mech if mech is not None else MISSING,
                          f"allowed one of: {', '.join(MECHANISMS)}", source)
     body = {k: v for k, v in data.items() if k != "mechanism"}

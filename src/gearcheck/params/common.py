@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 import tomllib
+import typing
 from pathlib import Path
 from typing import Any
 
@@ -18,6 +19,12 @@ from pydantic import BaseModel, ConfigDict, ValidationError
 
 # Guard against pathological files before any parsing work.
 MAX_TEMPLATE_BYTES = 1_000_000
+# Deepest nesting a template may have (a template is sections of keys, a key may hold a flat
+# list: 3 levels); deeper documents are rejected before anything walks them recursively.
+MAX_NESTING = 8
+# Longest value shown in an error line (strings, e.g. paths, get more room than numbers).
+MAX_SHOWN_CHARS = 60
+MAX_SHOWN_STRING_CHARS = 300
 
 
 class _Missing:
@@ -39,22 +46,29 @@ class ParamError(Exception):
         super().__init__(self._text())
 
     def _text(self) -> str:
-        where = f"{self.source}: " if self.source else ""
+        where = f"{_one_line(self.source)}: " if self.source else ""
         if self.field:
-            return f"{where}{self.field} = {_show(self.value)}: {self.allowed}"
-        return f"{where}{self.allowed}"
+            return f"{where}{_one_line(self.field)} = {_show(self.value)}: {_one_line(self.allowed)}"
+        return f"{where}{_one_line(self.allowed)}"
 
     def with_source(self, source: str) -> "ParamError":
         return ParamError(self.field, self.value, self.allowed, source)
 
 
+def _one_line(text: str) -> str:
+    """Control characters (a newline in a TOML key or file name) shown escaped: one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))
+
+
 def _show(value: Any) -> str:
-    if isinstance(value, str):
-        return repr(value)
     if isinstance(value, dict):
         return "{...}"
-    text = repr(value)
-    return text if len(text) <= 60 else text[:57] + "..."
+    try:
+        text = repr(value)
+    except ValueError:  # an int too long for repr (Python's digit limit)
+        text = f"<integer of about {int(value.bit_length() * 0.30103)} digits>"
+    limit = MAX_SHOWN_STRING_CHARS if isinstance(value, str) else MAX_SHOWN_CHARS
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 class Section(BaseModel):
@@ -97,6 +111,22 @@ def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:
     return ""
 
 
+def _field_type(model: type[BaseModel], path: tuple[str, ...]) -> str:
+    """The declared type at ``path`` (list items by index), e.g. 'list[float]', 'float'; '' if unknown."""
+    current: Any = model
+    for name in path:
+        fields = getattr(current, "model_fields", None)
+        if fields and name in fields:
+            current = fields[name].annotation
+        elif name.isdigit() and typing.get_origin(current) is list:
+            current = typing.get_args(current)[0]
+        else:
+            return ""
+    if isinstance(current, type):
+        return current.__name__
+    return str(current).replace("typing.", "")
+
+
 def _first_error(model: type[BaseModel], exc: ValidationError, data: dict) -> ParamError:
     err = exc.errors(include_url=False)[0]
     loc = tuple(str(p) for p in err["loc"])
@@ -108,23 +138,29 @@ def _first_error(model: type[BaseModel], exc: ValidationError, data: dict) -> Pa
         for name in loc[:-1]:
             parent = parent.model_fields[name].annotation if name in getattr(parent, "model_fields", {}) else None
         known = ", ".join(sorted(parent.model_fields)) if parent is not None and hasattr(parent, "model_fields") else ""
-        return ParamError(path, value, f"unknown key (known keys here: {known})")
+        return ParamError(path, value, f"unknown key (allowed keys here: {known})")
     if kind == "missing":
         return ParamError(path, MISSING, "required key is missing")
     allowed = field_range(model, loc)
+    if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2 ** 1023:
+        # a TOML integer beyond any float: pydantic calls it the wrong type
+        return ParamError(path, value, f"out of range (larger than any float): {allowed}" if allowed
+                          else "out of range (larger than any float)")
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
         return ParamError(path, value, f"out of range: {allowed}")
     if kind == "finite_number":
         return ParamError(path, value, f"must be a finite number ({allowed})" if allowed else "must be a finite number")
     if kind.endswith("_type") or kind.endswith("_parsing"):
         detail = err["msg"].lower()
-        extra = f"; {allowed}" if allowed else ""
+        wanted = _field_type(model, loc)
+        extra = f"; {allowed}" if allowed else (f"; allowed type: {wanted}" if wanted else "")
         return ParamError(path, value, f"wrong type: {detail}{extra}")
     return ParamError(path, value, err["msg"] + (f" ({allowed})" if allowed else ""))
 
 
 def validate(model: type[BaseModel], data: dict, source: str = "") -> BaseModel:
     """Validate ``data`` against ``model``; any failure becomes one :class:`ParamError`."""
+    _reject_non_finite(data, (), source, model)
     try:
         return model.model_validate(data)
     except ValidationError as exc:
@@ -144,10 +180,17 @@ def parse_override(text: str) -> tuple[tuple[str, ...], Any]:
     if not key or any(not p for p in path):
         raise ParamError("--set", text, "expected section.key=value")
     raw = raw.strip()
+    if len(path) > MAX_NESTING:
+        raise ParamError("--set", key, f"key nested {len(path)} levels deep; allowed at most {MAX_NESTING}")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
         value = raw
+    except ValueError:  # an integer of more digits than int() reads
+        raise ParamError("--set", key, "value is an integer with too many digits to read") from None
+    except RecursionError:
+        raise ParamError("--set", key, f"value nested too deeply; allowed at most {MAX_NESTING} levels") from None
+    _check_nesting(value, "--set " + key, len(path))
     return path, value
 
 
@@ -189,7 +232,8 @@ def read_toml(path: Path) -> dict:
     if size > MAX_TEMPLATE_BYTES:
         raise ParamError("", None, f"file is {size} bytes; a template is at most {MAX_TEMPLATE_BYTES}", source)
     try:
-        text = path.read_bytes().decode("utf-8")
+        # utf-8-sig: a byte-order mark (some Windows editors write one) is not part of the text
+        text = path.read_bytes().decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise ParamError("", None, f"not UTF-8 text (byte {exc.start}): is this a TOML template?", source) from None
     except OSError as exc:
@@ -198,16 +242,39 @@ def read_toml(path: Path) -> dict:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ParamError("", None, f"not valid TOML: {exc}", source) from None
-    _reject_non_finite(data, (), source)
+    except ValueError:  # int() refuses integers of more than sys.get_int_max_str_digits() digits
+        raise ParamError("", None, "not a template: an integer has too many digits to read", source) from None
+    except RecursionError:  # tomllib parses nested arrays / inline tables recursively
+        raise ParamError("", None, f"not a template: values nested too deeply (allowed at most {MAX_NESTING} levels)",
+                         source) from None
+    _check_nesting(data, "", 0, source)
     return data
 
 
-def _reject_non_finite(node: Any, path: tuple[str, ...], source: str) -> None:
+def _check_nesting(node: Any, where: str, depth: int, source: str = "") -> None:
+    """Reject documents nested deeper than MAX_NESTING (walked without recursion)."""
+    stack = [(node, depth)]
+    while stack:
+        item, level = stack.pop()
+        if level > MAX_NESTING:
+            raise ParamError(where, "{...}", f"nested {level} levels deep; a template allows at most {MAX_NESTING}",
+                             source)
+        if isinstance(item, dict):
+            stack.extend((v, level + 1) for v in item.values())
+        elif isinstance(item, list):
+            stack.extend((v, level + 1) for v in item)
+
+
+def _reject_non_finite(node: Any, path: tuple[str, ...], source: str, model: type[BaseModel] | None = None) -> None:
+    """NaN/inf anywhere in the document (TOML spells them nan, inf) is one error naming the field
+    and, when the model knows it, the field's allowed range."""
     if isinstance(node, dict):
         for k, v in node.items():
-            _reject_non_finite(v, path + (k,), source)
+            _reject_non_finite(v, path + (k,), source, model)
     elif isinstance(node, float) and not math.isfinite(node):
-        raise ParamError(".".join(path), node, "must be a finite number", source)
+        allowed = field_range(model, path) if model is not None else ""
+        raise ParamError(".".join(path), node, f"must be a finite number ({allowed})" if allowed
+                         else "must be a finite number", source)
 
 
 def to_toml(data: dict) -> str:

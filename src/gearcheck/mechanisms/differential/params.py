@@ -3,7 +3,10 @@
 One pydantic model per section; field names carry units; ranges are physical limits, not the
 paper's window. Geometric rules that need no CAD are checked here (undercut, tip interference,
 pointed tips, contact ratio, face width, common apex, negative warm backlash); each rejection
-is one :class:`ParamError` naming the field, its value and the allowed range.
+is one :class:`ParamError` naming the field, its value and the allowed range. The model also
+builds the CAD's own gear specs (poses.gear_specs → BevelGearSpec checks), so a set the CAD could
+not build (back faces in front of the roots, bores above the toe roots, a face cone too flat) is
+rejected before any CAD work.
 """
 
 from __future__ import annotations
@@ -12,7 +15,7 @@ import math
 
 from pydantic import Field, model_validator
 
-from gearcheck.mechanisms.differential import analysis  # numpy only
+from gearcheck.mechanisms.differential import analysis, poses  # numpy only
 from gearcheck.params.common import ParamError, Section
 
 # The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
@@ -61,7 +64,9 @@ class Gears(Section):
         x = self.small_profile_shift
         x_max = analysis.max_small_shift_for_tip(geom, alpha)
         x_min = max(mesh.small_undercut_min_shift, analysis.min_small_shift_for_interference(geom, alpha))
-        shift_range = f"allowed {x_min:.3f} to {x_max:.3f}"
+        shift_range = (f"allowed {x_min:.3f} to {x_max:.3f}" if x_min <= x_max else
+                       f"no shift allowed at {self.small_teeth}/{self.big_teeth} teeth and {self.pressure_angle_deg:g}° "
+                       f"(no undercut needs >= {x_min:.3f}, a 0.25·m tip land <= {x_max:.3f})")
         if x < mesh.small_undercut_min_shift:
             raise ParamError("gears.small_profile_shift", x,
                              f"{shift_range}: the small gear is undercut "
@@ -78,8 +83,11 @@ class Gears(Section):
                              f"{mesh.small_tip_thickness_mm:.3f} mm thick on the back cone, less than "
                              f"0.25·m = {min_tip:.3f} mm")
         if mesh.big_tip_thickness_mm < min_tip:
+            # the big gear (shift −x) thins as x falls
+            x_low = _boundary(lambda v: analysis.virtual_mesh(geom, alpha, v).big_tip_thickness_mm >= min_tip, x_max, x)
+            bound = f"allowed >= {x_low:.3f}" if x_low is not None else "no shift allowed up to the small gear's limit"
             raise ParamError("gears.small_profile_shift", x,
-                             f"too small: pointed teeth, the big gear's tip (shift −x) is "
+                             f"{bound}: pointed teeth, the big gear's tip (shift −x) is "
                              f"{mesh.big_tip_thickness_mm:.3f} mm thick on the back cone, less than 0.25·m = {min_tip:.3f} mm")
         if mesh.contact_ratio < analysis.MIN_CONTACT_RATIO:
             raise ParamError("gears.small_profile_shift", x,
@@ -220,4 +228,80 @@ class Params(Section):
             raise ParamError("backlash.mesh_thinning_min_mm", self.backlash.mesh_thinning_min_mm,
                              f"allowed > 0 mm with shim.thickness_mm = {self.shim.thickness_mm}: the warm backlash "
                              f"would be {warm_min_per_side:.2f}′ per side (the mesh binds at room temperature)")
+        why = _cad_blocker(self)
+        if why is not None:
+            raise _blame(self, why)
         return self
+
+
+# -- the CAD's own gear specs ----------------------------------------------------------------
+# `gearcheck build` makes its gears from poses.gear_specs (BevelGearSpec checks its cones, tip
+# land, root space and blank in __post_init__) and places them with poses.assembly_poses. The
+# model builds the same specs, so a set the CAD could not build is rejected here, before any CAD
+# work; the blame goes to the input that moves the failing check, with its allowed range found
+# by bisection on that same check.
+
+def _cad_blocker(params: "Params") -> str | None:
+    """Why the CAD could not make these gears (BevelGearSpec's message), or None."""
+    try:
+        specs = poses.gear_specs(params)
+        poses.assembly_poses(specs, params.shim.thickness_mm)
+    except ValueError as exc:
+        return str(exc)
+    return None
+
+
+def _with(params: "Params", section: str, **values) -> "Params":
+    """A copy with some fields of one section replaced (not validated: for probing the specs)."""
+    return params.model_copy(update={section: getattr(params, section).model_copy(update=values)})
+
+
+def _boundary(ok, good: float, bad: float, steps: int = 50) -> float | None:
+    """Where ``ok`` changes between ``good`` and ``bad`` (bisection); None if ``ok(good)`` fails."""
+    if not ok(good):
+        return None
+    for _ in range(steps):
+        mid = 0.5 * (good + bad)
+        good, bad = (mid, bad) if ok(mid) else (good, mid)
+    return good
+
+
+def _blame(params: "Params", why: str) -> ParamError:
+    g, d = params.gears, params.dimensions
+    geom = analysis.cone_geometry(g.module_mm, g.big_teeth, g.small_teeth)
+
+    def cured(section: str, **values) -> bool:
+        blocker = _cad_blocker(_with(params, section, **values))
+        return blocker is None or blocker.split(":")[0] != why.split(":")[0]
+
+    if "mounting_distance" in why:  # a back (mounting) face in front of its gear's outer root
+        # Probe one gear at a time, the other's face moved far back (both messages read alike).
+        far = 500.0
+        small_a = lambda v: 2.0 * (v + geom.big_pitch_diameter_mm / 2.0)  # noqa: E731  a/2 = l2 + d1/2
+        if not cured("dimensions", l12_mm=far):
+            l2 = _boundary(lambda v: cured("dimensions", l12_mm=far, a_mm=small_a(v)), far, d.l2_mm)
+            bound = f"allowed >= {l2:.3f} mm" if l2 is not None else f"no length up to {far:g} mm allowed"
+            return ParamError("dimensions.l2_mm", d.l2_mm,
+                              f"{bound}: the small gear's mounting face (a/2 = l2 + d1/2 from the apex) must lie "
+                              "behind its outer root (change a_mm with it)")
+        l12 = _boundary(lambda v: cured("dimensions", l12_mm=v), far, d.l12_mm)
+        bound = f"allowed >= {l12:.3f} mm" if l12 is not None else f"no length up to {far:g} mm allowed"
+        return ParamError("dimensions.l12_mm", d.l12_mm,
+                          f"{bound}: the big gear's body must reach behind its outer root "
+                          "(back face d2/2 + l12 from the apex; change b_mm with it)")
+    if "front_face" in why:  # the bore does not fit under the inner (toe) root
+        m = _boundary(lambda v: cured("gears", module_mm=v), 10.0, g.module_mm)
+        bound = f"allowed >= {m:.3f} mm at these tooth counts" if m is not None else "no module up to 10 mm allowed"
+        return ParamError("gears.module_mm", g.module_mm,
+                          f"{bound}: the gear bores ({poses.BIG_GEAR_BORE_MM:g} mm big, {poses.SMALL_GEAR_BORE_MM:g} mm "
+                          "small) must lie under the roots at the inner end of the teeth")
+    if "face cone" in why:
+        z1 = next((n for n in range(g.big_teeth - 1, g.small_teeth - 1, -1) if cured("gears", big_teeth=n)), None)
+        bound = f"allowed <= {z1}" if z1 is not None else f"no count allowed down to small_teeth = {g.small_teeth}"
+        return ParamError("gears.big_teeth", g.big_teeth,
+                          f"{bound} with {g.small_teeth} small teeth: the big gear's face cone is too flat "
+                          "(face angle >= 85°) to cut planar tooth sections")
+    if "pointed" in why or "root" in why:
+        return ParamError("gears.small_profile_shift", g.small_profile_shift,
+                          f"allowed: a shift that leaves both gears a tip land and a root space ({why})")
+    return ParamError("gears", g.model_dump(), f"allowed: gears the CAD can build ({why})")

@@ -4,6 +4,10 @@ Only inputs: the pinion and rack basic profiles, the sector and rack tooth indic
 height H, the machined trims (hS2…hS8, RS1), the contact-ratio design rule and the two angle
 requirements. Everything the paper derives (r, Ra, h, p, s, L, hS4 from ε, …) is computed.
 Cross-field rules raise :class:`ParamError` naming one field, its value and the allowed range.
+They include what the CAD needs (no pointed tooth or cutter tip, a rack root space, the pinion
+bore inside the root circle: the same RackPinionGeometry properties and layout constants the CAD
+builds from) and the trims the pinion tip must clear (hS8, hS6 under the paper's tangents), so a
+set the CAD could not build is rejected before any CAD work.
 """
 
 from __future__ import annotations
@@ -12,18 +16,24 @@ import math
 
 from pydantic import Field, model_validator
 
+from gearcheck.mechanisms.steering import analysis, layout
 from gearcheck.params import ParamError, Section
 
 MM = {"unit": "mm"}
 DEG = {"unit": "deg"}
+# A tooth whose top land is thinner than this (in modules) is taken as pointed (as for the
+# differential's bevel gears); applies to the pinion tip and the rack tooth top.
+MIN_TOP_LAND_MODULES = 0.25
+ADDENDUM_MIN = 0.5  # least pinion addendum coefficient (field range)
+TEETH_MAX = 400  # most pinion teeth (field range)
 
 
 class Pinion(Section):
     module_mm: float = Field(gt=0, le=50, description="Module m (paper: 4; see docs/steering.md for why not 5)", json_schema_extra=MM)
-    teeth: int = Field(ge=10, le=400, description="Tooth count z of the full pinion (the sector is part of it)")
+    teeth: int = Field(ge=10, le=TEETH_MAX, description="Tooth count z of the full pinion (the sector is part of it)")
     profile_shift: float = Field(ge=-1.0, le=1.0, description="Profile shift coefficient x")
     pressure_angle_deg: float = Field(ge=10.0, le=35.0, description="Pressure angle α", json_schema_extra=DEG)
-    addendum_coefficient: float = Field(ge=0.5, le=1.5, description="Addendum ha* (tip radius r + (ha* + x)·m)")
+    addendum_coefficient: float = Field(ge=ADDENDUM_MIN, le=1.5, description="Addendum ha* (tip radius r + (ha* + x)·m)")
     dedendum_coefficient: float = Field(ge=0.5, le=2.0, description="Dedendum hf* = addendum of the generating rack cutter (sharp tip)")
     sector_first_tooth: int = Field(ge=-200, le=0, description="Index j of G1, the first sector tooth, topped to RS1 (angle-0 convention: tooth j centred at (j + 1/2)·360°/z)")
     sector_last_tooth: int = Field(ge=0, le=200, description="Index j of the last sector tooth (G1's mirror), topped to RS1")
@@ -105,10 +115,8 @@ def _check(p: Params) -> None:
     if depth > r * math.sin(a) ** 2:
         z_min = 2.0 * (pin.dedendum_coefficient - x) / math.sin(a) ** 2
         raise ParamError("pinion.teeth", z, f"undercut by the generating rack at this shift and dedendum: allowed >= {math.ceil(z_min)}")
-    half_pitch_angle = (math.pi / 2 + 2 * x * math.tan(a)) / z
-    alpha_tip = math.acos(rb / tip)
-    if half_pitch_angle + _inv(a) - _inv(alpha_tip) <= 0:
-        raise ParamError("pinion.addendum_coefficient", pin.addendum_coefficient, "pointed pinion teeth at this shift: lower the addendum or the shift")
+    g = analysis.geometry_from_params(p)
+    _check_tooth_forms(g)
     rack_root = H - r - x * m - rack.dedendum_coefficient * m
     if rack_root <= 0:
         raise ParamError("layout.centre_to_datum_mm", H,
@@ -123,13 +131,19 @@ def _check(p: Params) -> None:
     def h_for_ratio(eps: float) -> float:
         return h + math.sin(a) * (eps * base_pitch - recess)
 
+    eps_top = ((top - h) / math.sin(a) + recess) / base_pitch
+    if eps_top < 1.0:
+        # contact ratio 1 needs the rack top at h1; the rack addendum sets the top
+        ha_min = (analysis.trim_height_for_contact_ratio(g, 1.0) - g.rack_reference_height) / m
+        raise ParamError("rack.addendum_coefficient", rack.addendum_coefficient,
+                         f"allowed >= {ha_min:.3f}: the untrimmed rack's contact ratio is {eps_top:.3f} < 1 "
+                         "(a tooth pair lets go before the next engages)")
     for name in ("hS2_mm", "hS4_mm", "hS6_mm", "hS8_mm"):
         value = getattr(trim, name)
         lo = max(h, h_for_ratio(1.0)) if name == "hS4_mm" else h
         why = "contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm" else "above the rack pitch line, at most the rack tooth top"
         if not (lo < value <= top):
             raise ParamError(f"trim.{name}", value, f"allowed >{lo:.3f} to {top:.3f} mm ({why})")
-    eps_top = ((top - h) / math.sin(a) + recess) / base_pitch
     if trim.min_contact_ratio > eps_top:
         raise ParamError("trim.min_contact_ratio", trim.min_contact_ratio,
                          f"allowed 1 to {eps_top:.3f} (the untrimmed rack's contact ratio)")
@@ -141,10 +155,88 @@ def _check(p: Params) -> None:
     if not (rs1_lo < rs1 <= tip):
         raise ParamError("pinion.topped_radius_mm", rs1,
                          f"allowed >{rs1_lo:.3f} to {tip:.3f} mm (G1's tip circle must reach S2 at height hS2; at most the tip radius)")
+    _check_trim_clearance(g)
 
 
-def _inv(a: float) -> float:
-    return math.tan(a) - a
+def _check_tooth_forms(g) -> None:
+    """Teeth the CAD can build: pinion tip land and rack top land >= MIN_TOP_LAND_MODULES·m, a
+    root land between the pinion's fillets (the generating cutter's tip is not pointed), a root
+    space between adjacent rack teeth, and the pinion bore inside the root circle."""
+    m, x = g.module_mm, g.profile_shift
+    tan_a = math.tan(g.pressure_angle_rad)
+    land_min = MIN_TOP_LAND_MODULES * m
+
+    def pinion_tip_land(geo) -> float:
+        return 2.0 * geo.tip_radius * float(geo.involute_half_angle(geo.tip_radius))
+
+    if pinion_tip_land(g) < land_min:
+        lo = ADDENDUM_MIN
+        if pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=lo)) < land_min:
+            x_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, profile_shift=v)) >= land_min, -1.0, x)
+            raise ParamError("pinion.profile_shift", x,
+                             f"allowed <= {x_max:.3f}: pointed pinion teeth, tip land "
+                             f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+        ha_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v)) >= land_min,
+                           lo, g.pinion_addendum_coefficient)
+        raise ParamError("pinion.addendum_coefficient", g.pinion_addendum_coefficient,
+                         f"allowed <= {ha_max:.3f} at this shift: pointed pinion teeth, tip land "
+                         f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+    w0 = g.rack_half_thickness_at_rolling_line
+    if g.cutter_tip_half_width <= 0.0:
+        raise ParamError("pinion.dedendum_coefficient", g.pinion_dedendum_coefficient,
+                         f"allowed < {x + w0 / (m * tan_a):.3f} at this shift and pressure angle: the generating "
+                         "rack's tip comes to a point, leaving no root land between the pinion's fillets")
+    rack_top_land = 2.0 * float(g.rack_half_width(g.rack_top_height))
+    if rack_top_land < land_min:
+        raise ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient,
+                         f"allowed <= {x + (w0 - land_min / 2.0) / (m * tan_a):.3f}: pointed rack teeth, top land "
+                         f"{rack_top_land:.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+    if not 2.0 * float(g.rack_half_width(g.rack_root_height)) < g.pitch:
+        raise ParamError("rack.dedendum_coefficient", g.rack_dedendum_coefficient,
+                         f"allowed < {(g.pitch / 2.0 - w0) / (m * tan_a) - x:.3f}: adjacent rack teeth would "
+                         "meet above the rack root line (no tooth space left)")
+    if not layout.bore_fits(g.root_radius):
+        z_min = next((n for n in range(g.teeth + 1, TEETH_MAX + 1) if layout.bore_fits(analysis.with_inputs(g, teeth=n).root_radius)), None)
+        if z_min is None:
+            m_min = _boundary(lambda v: layout.bore_fits(analysis.with_inputs(g, module_mm=v).root_radius), 50.0, m)
+            raise ParamError("pinion.module_mm", m,
+                             f"allowed >= {m_min:.3f} mm at z = {g.teeth}: the root circle (radius {g.root_radius:.2f} mm) "
+                             f"must clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
+        raise ParamError("pinion.teeth", g.teeth,
+                         f"allowed >= {z_min} at m = {m:g} mm: the root circle (radius {g.root_radius:.2f} mm) must "
+                         f"clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
+
+
+def _check_trim_clearance(g) -> None:
+    """The trimmed tops S4–S8 and S2–S6 must stay under the tangents the pinion's tip circles
+    (Ra at S4, RS1 at S2) sweep over them (paper eqs (8)–(16), :func:`analysis.tangent_top_height`,
+    the construction `gearcheck calc` reports as hS8_max / hS6_max): a higher corner is one the
+    pinion tip cannot clear, so it drags the rack on past the designed disengagement."""
+    first = g.rack_first_tooth
+    travel_s3s4 = analysis.travel_corner_on_circle(g, first + 1, g.hS4_mm, g.tip_radius)
+    hs8_max = analysis.tangent_top_height(g, g.trim_corners(travel_s3s4)["S4"], first + 1, travel_s3s4)
+    h = g.rolling_line_height
+    if g.hS8_mm > hs8_max:
+        raise ParamError("trim.hS8_mm", g.hS8_mm,
+                         f"allowed >{h:.3f} to {hs8_max:.3f} mm: the pinion tip circle (Ra) cannot clear S8 above "
+                         "its tangent at S4 (hS8_max)")
+    travel_s1s2 = analysis.travel_corner_on_circle(g, first, g.hS2_mm, g.topped_radius_mm)
+    hs6_max = analysis.tangent_top_height(g, g.trim_corners(travel_s1s2)["S2"], first, travel_s1s2)
+    if g.hS6_mm > hs6_max:
+        raise ParamError("trim.hS6_mm", g.hS6_mm,
+                         f"allowed >{h:.3f} to {hs6_max:.3f} mm: G1's topped tip circle (RS1) cannot clear S6 above "
+                         "its tangent at S2 (hS6_max)")
+
+
+def _boundary(ok, good: float, bad: float, steps: int = 60) -> float:
+    """Where ``ok`` changes between ``good`` (ok) and ``bad`` (not ok), by bisection; ``good`` if
+    ``ok(good)`` fails too (no boundary in the bracket)."""
+    if not ok(good):
+        return good
+    for _ in range(steps):
+        mid = 0.5 * (good + bad)
+        good, bad = (mid, bad) if ok(mid) else (good, mid)
+    return good
 
 
 def _form_radius(r: float, rb: float, a: float, depth: float) -> float:

@@ -29,6 +29,14 @@ DEFAULT_ENTRY_ANGLE_DEG = 90.0
 DEFAULT_WRAP_ANGLE_DEG = 120.0
 
 
+class BoreTooLarge(ValueError):
+    """The shaft bore does not fit under the middle groove's floor."""
+
+
+class RowsWithoutGroove(ValueError):
+    """Two or more tooth rows with no middle groove between them (a zero-length hub)."""
+
+
 @dataclass(frozen=True)
 class SprocketSpec:
     """Everything the sprocket solid needs (mm)."""
@@ -61,9 +69,11 @@ def sprocket_spec(params, middle_groove_depth_mm: float = MIDDLE_GROOVE_DEPTH_MM
     d = iso606.every_other_tooth_pitch_diameter(ch.pitch_mm, sp.teeth)
     gap = iso606.tooth_gap(d, sp.teeth, sp.seating_radius_mm, sp.flank_radius_mm, sp.seating_angle_deg,
                            d + sp.tip_over_pitch_mm)
+    if sp.tooth_rows > 1 and not sp.middle_groove_width_mm > 0.0:
+        raise RowsWithoutGroove("tooth rows need a middle groove between them")
     hub = hub_radius_mm(d, gap.seating_radius_mm, middle_groove_depth_mm)
     if not bore_diameter_mm / 2.0 < hub:
-        raise ValueError("bore larger than the middle groove's floor")
+        raise BoreTooLarge("bore larger than the middle groove's floor")
     return SprocketSpec(gap, sp.tooth_width_mm, sp.tooth_rows, sp.middle_groove_width_mm, hub,
                         bore_diameter_mm / 2.0)
 

@@ -3,7 +3,9 @@
 Field ranges are physical limits; the cross-field rules (odd tooth count, a tooth left between
 adjacent grooves, the ISO 606 seating limits, a tip land left under the tip circle, widths that
 fit) live in :class:`Params` and each raise one :class:`ParamError` naming the field, the value
-and the allowed range computed from the other inputs.
+and the allowed range computed from the other inputs. Last, the model builds the layout the CAD
+builds from (:mod:`.layout`: sprocket spec with its bore, link section, default chain wrap), so a
+set the CAD could not build is rejected before any CAD work.
 """
 
 from __future__ import annotations
@@ -11,10 +13,13 @@ from __future__ import annotations
 from pydantic import Field, model_validator
 
 from gearcheck.geometry import iso606
+from gearcheck.geometry import track_chain as tc
+from gearcheck.mechanisms.track import analysis, layout
 from gearcheck.params import ParamError, Section
 
 MIN_TEETH = 7
 MAX_TEETH = 301
+TIP_GAP_MIN_MM = 0.05
 
 
 def _f(lo=None, hi=None, *, gt=None, lt=None, unit="", description=""):
@@ -63,7 +68,7 @@ class Sprocket(Section):
 
 
 class TrackPlate(Section):
-    tip_gap_mm: float = _f(0.05, 5, unit="mm", description="chosen gap from tooth tip to a seated link's plate")
+    tip_gap_mm: float = _f(TIP_GAP_MIN_MM, 5, unit="mm", description="chosen gap from tooth tip to a seated link's plate")
     required_gap_min_mm: float = _f(0, 5, unit="mm", description="paper's required gap, lower end")
     required_gap_max_mm: float = _f(0, 5, unit="mm", description="paper's required gap, upper end")
 
@@ -153,7 +158,69 @@ class Params(Section):
         if not t.required_gap_min_mm <= t.required_gap_max_mm:
             raise ParamError("track_plate.required_gap_min_mm", t.required_gap_min_mm,
                              f"allowed <= required_gap_max_mm = {t.required_gap_max_mm:g} mm")
+        self._check_buildable()
         return self
+
+    def _check_buildable(self) -> None:
+        """Build the layout `gearcheck build` builds its solids from (:mod:`.layout`, the same
+        functions), so a set the CAD cannot build stops here; each failure names its field."""
+        s, c = self.sprocket, self.chain
+        z, p = s.teeth, c.pitch_mm
+        try:
+            spec = layout.sprocket_spec(self)
+        except iso606.ToothFormError as exc:  # _check_tip_land rejects these first; kept as a guard
+            raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm, f"no valid tooth: {exc}") from None
+        except layout.RowsWithoutGroove:
+            raise ParamError("sprocket.middle_groove_width_mm", s.middle_groove_width_mm,
+                             f"allowed > 0 mm with {s.tooth_rows} tooth rows: the guide-lug groove separates the "
+                             "rows (for one wide row, set tooth_rows = 1)") from None
+        except layout.BoreTooLarge:
+            bore, depth = layout.BORE_DIAMETER_MM, layout.MIDDLE_GROOVE_DEPTH_MM
+
+            def fits(teeth: int) -> bool:
+                d = iso606.every_other_tooth_pitch_diameter(p, teeth)
+                return layout.hub_radius_mm(d, s.seating_radius_mm) > bore / 2.0
+
+            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if fits(n)), None)
+            allowed = f"allowed odd {z_min} to {MAX_TEETH}" if z_min else f"no odd count up to {MAX_TEETH} allowed"
+            raise ParamError("sprocket.teeth", z,
+                             f"{allowed} at p = {p:g} mm: the {bore:g} mm shaft bore must lie under the "
+                             f"middle groove floor, {depth:g} mm below the root circle (sprocket too small)") from None
+        try:
+            layout.default_wrap(z, p)
+        except ValueError as exc:
+            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if _wrap_fits(n, p)), None)
+            raise ParamError("sprocket.teeth", z,
+                             f"allowed odd {z_min} to {MAX_TEETH}: the chain segment built at θ = 0 "
+                             f"({layout.DEFAULT_WRAP_ANGLE_DEG:g}° wrap plus {layout.DEFAULT_RUN_LINKS} links on "
+                             f"each run) does not fit: {exc}") from None
+        try:
+            layout.link_geometry(self, spec.gap)
+        except ValueError:
+            raise self._link_error(spec.gap) from None
+
+    def _link_error(self, gap: iso606.ToothGap) -> ParamError:
+        """The plate face (e outside the pin line, set by the tip gap) must cut the sleeve far
+        enough for the plate to sit on it: tip gaps between the two e limits of the link."""
+        c, t = self.chain, self.track_plate
+        e_at_zero_gap = analysis.plate_offset_for_tip_gap(gap, 0.0)
+        e_max = _largest_joining_offset(c.pitch_mm, c.sleeve_diameter_mm, c.track_width_mm)
+        gap_lo, gap_hi = max(-e_at_zero_gap, TIP_GAP_MIN_MM), e_max - e_at_zero_gap
+        if gap_lo < gap_hi:
+            return ParamError("track_plate.tip_gap_mm", t.tip_gap_mm,
+                              f"allowed {gap_lo:.3f} to {gap_hi:.3f} mm: the link plate's face (e = tip gap + "
+                              f"{e_at_zero_gap:.3f} mm outside the pin line) must cut the {c.sleeve_diameter_mm:g} mm "
+                              "sleeve deep enough to join it")
+        # No tip gap works: the sleeve is too thin. Smallest sleeve that joins at the least gap.
+        e_needed = e_at_zero_gap + TIP_GAP_MIN_MM
+        lo, hi = c.sleeve_diameter_mm, 2.0 * e_needed + 10.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if _largest_joining_offset(c.pitch_mm, mid, c.track_width_mm) > e_needed else (mid, hi)
+        return ParamError("chain.sleeve_diameter_mm", c.sleeve_diameter_mm,
+                          f"allowed > {hi:.3f} mm: a thinner sleeve cannot join the link plate, whose face lies "
+                          f"{e_needed:.3f} mm outside the pin line at the least tip gap {TIP_GAP_MIN_MM} mm")
+
 
     def _check_tip_land(self, d: float) -> None:
         """The tip circle must cut the flanks below the point where adjacent flanks meet."""
@@ -175,3 +242,31 @@ class Params(Section):
                              d + s.tip_over_pitch_mm)
         except iso606.ToothFormError as exc:  # not reachable inside the ISO limits; kept as a guard
             raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm, f"no valid tooth: {exc}") from None
+
+
+def _largest_joining_offset(pitch_mm: float, sleeve_diameter_mm: float, track_width_mm: float) -> float:
+    """Largest plate offset e for which :func:`track_chain.link_geometry` builds a link (it builds
+    for e in (0, e_max)); 0 if none."""
+
+    def joins(e: float) -> bool:
+        try:
+            tc.link_geometry(pitch_mm, sleeve_diameter_mm, e, track_width_mm)
+        except ValueError:
+            return False
+        return True
+
+    lo, hi = 0.0, sleeve_diameter_mm / 2.0
+    if not joins(hi * 1e-9):
+        return 0.0
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if joins(mid) else (lo, mid)
+    return lo
+
+
+def _wrap_fits(teeth: int, pitch_mm: float) -> bool:
+    try:
+        layout.default_wrap(teeth, pitch_mm)
+    except ValueError:
+        return False
+    return True
