@@ -1,0 +1,48 @@
+"""`gearcheck check` end to end on the track drive (the quickest sweep): files, exit codes,
+determinism, and reproduction from the run's own params.toml."""
+
+import json
+
+import pytest
+
+from gearcheck.cli import main
+
+pytestmark = pytest.mark.cad
+
+
+@pytest.fixture(scope="module")
+def first_run(tmp_path_factory, templates_dir):
+    out = tmp_path_factory.mktemp("check_a")
+    code = main(["check", str(templates_dir / "eod_track_drive.toml"), "--out", str(out)])
+    return code, out
+
+
+def test_check_writes_report_files_and_passes(first_run):
+    code, out = first_run
+    assert code == 0
+    for name in ("report.html", "summary.json", "sweep.csv", "manifest.json", "params.toml", "eod_track_drive.step"):
+        assert (out / name).is_file(), name
+    summary = json.loads((out / "summary.json").read_text())["track"]
+    assert summary["verdict_pass"] == 1
+    assert 0.5 <= summary["min_tip_plate_distance_mm"]
+    confirmation = summary["exact_confirmation"]
+    assert confirmation and all(abs(c["mesh_mm"] - c["brep_mm"]) <= c["bound_mm"] for c in confirmation.values())
+    assert "<svg" in (out / "report.html").read_text()
+
+
+def test_rerun_from_its_own_params_is_byte_identical(first_run, tmp_path):
+    """The result folder reproduces itself: same summary.json and sweep.csv, byte for byte."""
+    _, out = first_run
+    assert main(["check", str(out / "params.toml"), "--out", str(tmp_path)]) == 0
+    for name in ("summary.json", "sweep.csv"):
+        assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
+
+
+def test_failing_verdict_exits_1(tmp_path, templates_dir):
+    """A tip gap below the paper's 0.5 mm window is valid input but fails the window verdict."""
+    code = main(["check", str(templates_dir / "eod_track_drive.toml"), "--set", "track_plate.tip_gap_mm=0.3",
+                 "--out", str(tmp_path)])
+    assert code == 1
+    summary = json.loads((tmp_path / "summary.json").read_text())["track"]
+    assert summary["verdict_pass"] == 0
+    assert summary["verdicts"]["seated_tip_gap_in_window"] == 0
