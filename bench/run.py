@@ -79,7 +79,7 @@ def bench_sweeps(repeat: int) -> dict:
         parts = loaded.parts_module.build_parts(loaded.params)
         with tempfile.TemporaryDirectory() as tmp:
             _, exported = export_parts(parts, Path(tmp), name=loaded.name, mechanism=loaded.mechanism,
-                                       params_data=loaded.data)
+                                       params_data=loaded.resolved_data)
         bodies = sweep_bodies(exported)
         runs = []
         for _ in range(repeat):

@@ -27,7 +27,7 @@ def build_bodies(tmp_path_factory):
             parts = loaded.parts_module.build_parts(loaded.params)
             out = tmp_path_factory.mktemp(name)
             _, exported = export_parts(parts, out, name=name, mechanism=loaded.mechanism,
-                                       params_data=loaded.data, tol_mm=tol_mm)
+                                       params_data=loaded.resolved_data, tol_mm=tol_mm)
             cache[key] = (loaded, parts, sweep_bodies(exported))
         return cache[key]
 

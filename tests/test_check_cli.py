@@ -36,6 +36,7 @@ def test_rerun_from_its_own_params_is_byte_identical(first_run, tmp_path):
     assert main(["check", str(out / "params.toml"), "--out", str(tmp_path)]) == 0
     for name in ("summary.json", "sweep.csv"):
         assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
+    assert (tmp_path / "eod_track_drive.step").is_file()  # the result keeps its name
 
 
 def test_failing_verdict_exits_1(tmp_path, templates_dir):

@@ -135,3 +135,15 @@ def test_resolved_parameters_round_trip_through_toml(tmp_path, templates_dir, na
     again = load_template(copy)
     assert again.params == loaded.params
     assert again.data == loaded.data
+
+
+def test_optional_name_must_be_a_folder_name(tmp_path, templates_dir):
+    text = (templates_dir / "eod_track_drive.toml").read_text()
+    good = tmp_path / "good.toml"
+    good.write_text('name = "drive-A_1"\n' + text)
+    assert load_template(good).name == "drive-A_1"
+    assert load_template(templates_dir / "eod_track_drive.toml").name == "eod_track_drive"
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "../escape"\n' + text)
+    with pytest.raises(ParamError, match="name = '../escape'"):
+        load_template(bad)

@@ -251,7 +251,7 @@ def _build_one(loaded, folder: Path, tol_mm: float | None):
     with tqdm(total=len(parts), desc=f"meshing {loaded.name}", unit="part", file=sys.stderr,
               disable=not sys.stderr.isatty()) as bar:
         manifest, exported = export_parts(
-            parts, folder, name=loaded.name, mechanism=loaded.mechanism, params_data=loaded.data,
+            parts, folder, name=loaded.name, mechanism=loaded.mechanism, params_data=loaded.resolved_data,
             tol_mm=tol_mm if tol_mm is not None else CHORDAL_TOL_MM,
             progress=lambda _name: bar.update(1),
         )

@@ -8,6 +8,7 @@ only). CAD, poses and checks live in submodules imported only when needed.
 from __future__ import annotations
 
 import importlib
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from types import ModuleType
@@ -16,6 +17,9 @@ from pydantic import BaseModel
 
 from gearcheck.params import ParamError, apply_overrides, read_toml, validate
 from gearcheck.params.common import MISSING
+
+# An optional top-level `name` names the result files; it must be a plain folder name.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
 
 MECHANISMS = {
     "differential": "gearcheck.mechanisms.differential",
@@ -53,7 +57,15 @@ class Loaded:
 
     @property
     def name(self) -> str:
-        return self.path.stem
+        """Result name: the template's optional top-level ``name``, else the file's stem (so a
+        rerun from ``out/NAME/params.toml`` keeps NAME)."""
+        return self.data.get("name") or self.path.stem
+
+    @property
+    def resolved_data(self) -> dict:
+        """The resolved parameters with the result name recorded, as written to params.toml."""
+        rest = {k: v for k, v in self.data.items() if k not in ("mechanism", "name")}
+        return {"mechanism": self.mechanism, "name": self.name, **rest}
 
 
 def load_template(path: str | Path, overrides: list[str] | None = None) -> Loaded:
@@ -69,6 +81,9 @@ def load_template(path: str | Path, overrides: list[str] | None = None) -> Loade
     if not isinstance(mech, str) or mech not in MECHANISMS:
         raise ParamError("mechanism", mech if mech is not None else MISSING,
                          f"allowed one of: {', '.join(MECHANISMS)}", source)
-    body = {k: v for k, v in data.items() if k != "mechanism"}
+    name = data.get("name")
+    if name is not None and not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)):
+        raise ParamError("name", name, "allowed 1 to 64 characters of A-Z a-z 0-9 _ . - (a folder name)", source)
+    body = {k: v for k, v in data.items() if k not in ("mechanism", "name")}
     params = validate(mechanism_module(mech).Params, body, source)
     return Loaded(path=path, mechanism=mech, params=params, data=data)
