@@ -57,10 +57,11 @@ def plot_svg(plot: Plot) -> str:
             ax.plot(s.x, s.y, "o", ms=3.5, label=s.label)
         else:
             ax.plot(s.x, s.y, "-", lw=1.6, label=s.label)
-    for label, x in plot.markers:
+    for i, (label, x) in enumerate(sorted(plot.markers, key=lambda m: m[1])):
         ax.axvline(x, ls="--", lw=1.0, color="0.35")
-        ax.annotate(label, (x, 1.0), xycoords=("data", "axes fraction"), rotation=90, fontsize=8,
-                    va="top", ha="right", color="0.25")
+        # neighbouring markers (events a fraction of a degree apart) get staggered labels
+        ax.annotate(label, (x, 0.98 - 0.3 * (i % 3)), xycoords=("data", "axes fraction"), rotation=90,
+                    fontsize=7, va="top", ha="right", color="0.25")
     for label, y in plot.hlines:
         ax.axhline(y, ls=":", lw=1.2, color="#b03030")
         ax.annotate(label, (0.0, y), xycoords=("axes fraction", "data"), fontsize=8, va="bottom",
