@@ -92,27 +92,14 @@ def bench_sweeps(repeat: int) -> dict:
     return out
 
 
-def bench_check_all(repeat: int) -> dict:
-    """`gearcheck check --all` wall time in a fresh process (build, mesh, sweep, B-rep, report)."""
+def bench_command_all(command: str, repeat: int) -> dict:
+    """`gearcheck COMMAND --all` wall time in a fresh process (includes import cadquery)."""
     import subprocess
     import tempfile
 
     def run():
         with tempfile.TemporaryDirectory() as tmp:
-            subprocess.run([sys.executable, "-m", "gearcheck", "check", "--all", "--out", tmp],
-                           cwd=ROOT, check=True, capture_output=True)
-
-    return median_time(run, repeat)
-
-
-def bench_build_all(repeat: int) -> dict:
-    """`gearcheck build --all` wall time in a fresh process (includes import cadquery)."""
-    import subprocess
-    import tempfile
-
-    def run():
-        with tempfile.TemporaryDirectory() as tmp:
-            subprocess.run([sys.executable, "-m", "gearcheck", "build", "--all", "--out", tmp],
+            subprocess.run([sys.executable, "-m", "gearcheck", command, "--all", "--out", tmp],
                            cwd=ROOT, check=True, capture_output=True)
 
     return median_time(run, repeat)
@@ -132,9 +119,9 @@ def main() -> int:
         "cpus": __import__("os").cpu_count(),
         "calc": bench_calc(args.repeat),
         "build": bench_build(3),
-        "build_all_wall": bench_build_all(3),
+        "build_all_wall": bench_command_all("build", 3),
         "sweep": bench_sweeps(args.repeat_sweep),
-        "check_all_wall": bench_check_all(args.repeat_sweep),
+        "check_all_wall": bench_command_all("check", args.repeat_sweep),
     }
     atomic_write_text(args.out, json.dumps(result, indent=2) + "\n")
     for group in ("calc", "build"):

@@ -47,6 +47,18 @@ def _add_template_args(p: argparse.ArgumentParser) -> None:
     )
 
 
+def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
+    """TEMPLATE | --all, --set, --out, --tol: shared by `build` and `check`."""
+    p.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                   help="override one template value (repeatable)")
+    p.add_argument("--all", action="store_true", help=f"{verb} every template in templates/ into OUT/NAME")
+    p.add_argument("--out", type=Path, default=None,
+                   help="output folder (default out/NAME; with --all, the parent folder, default out)")
+    p.add_argument("--tol", type=float, default=None, metavar="MM",
+                   help="absolute chordal tolerance of the meshes in mm (default 0.01)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="gearcheck",
@@ -75,14 +87,7 @@ def build_parser() -> argparse.ArgumentParser:
         "DIR/manifest.json (materials, volumes, triangle counts, measured mesh error, file hashes). "
         "Every file is written atomically.",
     )
-    build.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
-    build.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                       help="override one template value (repeatable)")
-    build.add_argument("--all", action="store_true", help="build every template in templates/ into OUT/NAME")
-    build.add_argument("--out", type=Path, default=None,
-                       help="output folder (default out/NAME; with --all, the parent folder, default out)")
-    build.add_argument("--tol", type=float, default=None, metavar="MM",
-                       help="absolute chordal tolerance of the STL meshes in mm (default 0.01)")
+    _add_cad_args(build, "build")
 
     check = sub.add_parser(
         "check",
@@ -94,14 +99,7 @@ def build_parser() -> argparse.ArgumentParser:
         "geometry, plots), DIR/summary.json (numbers) and DIR/sweep.csv (one row per pose) beside "
         "the CAD. Exit 0 when every verdict passes, 1 when one fails, 2 on bad input.",
     )
-    check.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
-    check.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                       help="override one template value (repeatable)")
-    check.add_argument("--all", action="store_true", help="check every template in templates/ into OUT/NAME")
-    check.add_argument("--out", type=Path, default=None,
-                       help="output folder (default out/NAME; with --all, the parent folder, default out)")
-    check.add_argument("--tol", type=float, default=None, metavar="MM",
-                       help="absolute chordal tolerance of the meshes in mm (default 0.01)")
+    _add_cad_args(check, "check")
 
     demo = sub.add_parser("demo", help="every template in templates/: figures and CAD under --out (what `make demo` runs)")
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
