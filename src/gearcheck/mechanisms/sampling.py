@@ -15,6 +15,8 @@ a seeded database-free run) and :class:`random.Random` (``bench/fuzz.py``).
 
 from __future__ import annotations
 
+import copy
+
 import math
 import random
 from typing import Any, Callable, Protocol
@@ -232,16 +234,8 @@ SAMPLERS: dict[str, Callable[[dict, Draw], None]] = {
 }
 
 
-def _copy(data: Any) -> Any:
-    if isinstance(data, dict):
-        return {k: _copy(v) for k, v in data.items()}
-    if isinstance(data, list):
-        return [_copy(v) for v in data]
-    return data
-
-
 def sample(base: dict, draw: Draw) -> dict:
     """A new template body (TOML data, ``mechanism`` key kept) redrawn from ``base``."""
-    data = _copy(base)
+    data = copy.deepcopy(base)
     SAMPLERS[data["mechanism"]](data, draw)
     return data

@@ -8,6 +8,7 @@ so the CLI can print one line and exit 2.
 
 from __future__ import annotations
 
+import copy
 import math
 import tomllib
 import typing
@@ -196,7 +197,7 @@ def parse_override(text: str) -> tuple[tuple[str, ...], Any]:
 
 def apply_overrides(data: dict, overrides: list[str]) -> dict:
     """Return a copy of ``data`` with each ``--set`` override applied (type checks come later)."""
-    out = _deepcopy(data)
+    out = copy.deepcopy(data)
     for text in overrides:
         path, value = parse_override(text)
         node = out
@@ -209,14 +210,6 @@ def apply_overrides(data: dict, overrides: list[str]) -> dict:
             node = child
         node[path[-1]] = value
     return out
-
-
-def _deepcopy(data: Any) -> Any:
-    if isinstance(data, dict):
-        return {k: _deepcopy(v) for k, v in data.items()}
-    if isinstance(data, list):
-        return [_deepcopy(v) for v in data]
-    return data
 
 
 def read_toml(path: Path) -> dict:
