@@ -19,7 +19,7 @@ import copy
 
 import math
 import random
-from typing import Any, Callable, Protocol
+from typing import Callable, Protocol
 
 from gearcheck.geometry import iso606
 
