@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.geometry.bevel import BevelGearSpec, minus_flank_signed, flank_azimuth, mate_rotation
+from gearcheck.geometry.bevel import BevelGearSpec, flank_azimuth, line_of_action, mate_rotation, minus_flank_signed
 
 ARCMIN_PER_RAD = 10800.0 / math.pi
 
@@ -45,10 +45,13 @@ ARCMIN_PER_RAD = 10800.0 / math.pi
 # (checked against 160 × 33 samples with deeper refinement: ≤ 1e-4′ on the template's poses).
 PROFILE_SAMPLES = 28
 RULING_SAMPLES = 5
-# Teeth sampled on either side of the mesh zone (the contact spans ~1.5 pitches; non-conjugate
-# meshes close up the neighbours). A contact found on the outermost sampled tooth raises.
-BIG_TEETH_WINDOW = 2
-SMALL_TEETH_WINDOW = 2
+# Teeth sampled on either side of the mesh zone: the longer reach of the path of contact from
+# the pitch point, in pitches, rounded up, plus one (non-conjugate meshes close up the
+# neighbours), at least MIN_TEETH_WINDOW (see teeth_window; the template: 0.95 pitches → 2). A
+# contact found on the outermost sampled tooth still widens the window by one and solves
+# again, up to MAX_TEETH_WINDOW, beyond which it raises.
+MIN_TEETH_WINDOW = 2
+MAX_TEETH_WINDOW = 8
 # Secant solve of d(p, δ) = 0 per point: first step, iterations, convergence on the distance.
 SECANT_FIRST_STEP_RAD = 1e-3
 SECANT_ITERATIONS = 8
@@ -264,6 +267,17 @@ class _FlankSet:
         return np.where(ok, b, direction * np.inf)
 
 
+class _WindowTooNarrow(RuntimeError):
+    """The extreme lies on the last tooth sampled: a tooth beyond it may touch first."""
+
+
+def teeth_window(big: BevelGearSpec, small: BevelGearSpec) -> int:
+    """Teeth on either side of the mesh zone that the contact can reach (both gears)."""
+    path = line_of_action(big, small)
+    reach = max(path.pitch_arc - path.start_arc, path.end_arc - path.pitch_arc) / path.base_pitch_arc
+    return min(max(MIN_TEETH_WINDOW, math.ceil(reach) + 1), MAX_TEETH_WINDOW)
+
+
 def _first_contact(sets: list[_FlankSet], direction: int) -> Contact:
     """Extreme root over both flank sets (min for +, max for −): samples ranked by a one-step
     estimate, the best REFINE_CANDIDATES per set (separate local extremes: another tooth or two
@@ -295,8 +309,8 @@ def _first_contact(sets: list[_FlankSet], direction: int) -> Contact:
         raise RuntimeError("no contact within MAX_CONTACT_ANGLE_RAD: the gears are not in mesh")
     key, tooth, tb, ub, fs = best
     if tooth in (fs.teeth[0], fs.teeth[-1]):
-        raise RuntimeError(f"contact on the outermost sampled tooth ({'big' if fs.big else 'small'} "
-                           f"tooth {tooth}): widen the tooth window")
+        raise _WindowTooNarrow(f"contact on the outermost sampled tooth ({'big' if fs.big else 'small'} "
+                               f"tooth {tooth})")
     delta = direction * key
     p = fs._points(tooth, tb, ub)
     pose = fs.this.turned(delta).pose if fs.big else fs.this.pose
@@ -335,9 +349,13 @@ def big_gear_contact(big: PlacedGear, small: PlacedGear, direction: int) -> Cont
     if direction not in (-1, 1):
         raise ValueError("direction must be +1 or -1")
     side = direction  # + direction: side +1 flanks of both gears (module docstring)
-    sets = [_FlankSet(big, small, True, side, BIG_TEETH_WINDOW),
-            _FlankSet(small, big, False, side, SMALL_TEETH_WINDOW)]
-    return _first_contact(sets, direction)
+    for window in range(teeth_window(big.spec, small.spec), MAX_TEETH_WINDOW + 1):
+        sets = [_FlankSet(big, small, True, side, window), _FlankSet(small, big, False, side, window)]
+        try:
+            return _first_contact(sets, direction)
+        except _WindowTooNarrow as exc:
+            reason = exc
+    raise RuntimeError(f"{reason} with {MAX_TEETH_WINDOW} teeth on either side of the mesh zone")
 
 
 def big_gear_play(big: PlacedGear, small: PlacedGear) -> Play:

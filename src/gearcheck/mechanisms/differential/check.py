@@ -154,8 +154,7 @@ def pruned_meshes(bodies: dict[str, Body], specs, thermal: dict[str, GearThermal
             # +1 pitch in its own frame), the small gear +1 pitch (its zone moves −1 pitch)
             cb = round(_zone_azimuth(b.pose, s.pose) / big_spec.angular_pitch_rad)
             cs = round(_zone_azimuth(s.pose, b.pose) / small_spec.angular_pitch_rad)
-            wb = bp.BIG_TEETH_WINDOW + PRUNE_EXTRA_TEETH
-            ws = bp.SMALL_TEETH_WINDOW + PRUNE_EXTRA_TEETH
+            wb = ws = bp.teeth_window(big_spec, small_spec) + PRUNE_EXTRA_TEETH
             big_teeth = np.arange(cb - wb, cb + wb + 2)
             small_teeth = np.arange(cs - ws - 1, cs + ws + 1)
             for d in DIRECTIONS:

@@ -52,6 +52,16 @@ TRAVEL_TOL_MM = 1e-4  # rack standing still / a pair touching, within this (≫ 
 ANGLE_STEP_DEG = 0.05  # towing-curve grid; events are refined by bisection
 BISECT_TOL_RAD = 1e-7
 CHECK_ANGLES_DEG = (68.0, 72.0, 75.0)  # towing-curve sample points reported as figures
+# Only the rack's flanks push it. A trimmed top, even a steeply slanted one, is a cut the
+# pinion is meant to clear (its tip land grazes S2 at most): a tooth that has to drive the rack
+# through a top jams, and the overlap is reported as interference. A rack corner (a flank's end)
+# can push through the pinion's flank, but only while the contact normal lies within 60° of the
+# travel (|n_x| ≥ 0.5, flanks: cos α ≥ 0.82 for α ≤ 35°): flatter, the normal force would exceed
+# twice the push. That bounds how fast a tooth drives the rack, |dL/dφ| = |v·n| / |n_x| ≤
+# r_tip / 0.5; a push needing more within one step is a jam as well. The mesh sweep applies both
+# rules to its faces (flank triangles only) and its reach.
+PUSH_NORMAL_MIN = 0.5
+PUSH_RATE_PER_TIP_RADIUS = 1.0 / PUSH_NORMAL_MIN
 
 
 def geometry_from_params(params) -> RackPinionGeometry:
@@ -298,18 +308,17 @@ def solve_trims(g: RackPinionGeometry, min_contact_ratio: float, target_angle: f
 # ============================================================================================
 
 def _rack_chains(g: RackPinionGeometry, k: int):
-    """Left and right boundary of rack tooth k at L = 0 as increasing-y polylines."""
+    """Left and right boundary of rack tooth k at L = 0 as increasing-y polylines (y, x): the
+    top (S2–S6 or S4–S8) joins the chain on its lower side. Also its two flanks alone (the
+    faces that push the rack), the root height and the top height."""
     bl, br, tr, tl = g.rack_tooth_polygon(k, 0.0)
     y0, h_l, h_r = bl[1], tl[1], tr[1]
-    if h_r > h_l:
-        left = (np.array([y0, h_l, h_r]), np.array([bl[0], tl[0], tr[0]]))
-    else:
-        left = (np.array([y0, h_l]), np.array([bl[0], tl[0]]))
-    if h_l > h_r:
-        right = (np.array([y0, h_r, h_l]), np.array([br[0], tr[0], tl[0]]))
-    else:
-        right = (np.array([y0, h_r]), np.array([br[0], tr[0]]))
-    return left, right, np.array([bl, br, tr, tl]), y0, max(h_l, h_r)
+    left_pts, right_pts = [bl, tl] + ([tr] if h_r > h_l else []), [br, tr] + ([tl] if h_l > h_r else [])
+
+    def chain(pts):
+        return np.array([q[1] for q in pts]), np.array([q[0] for q in pts])
+
+    return chain(left_pts), chain(right_pts), chain([bl, tl]), chain([br, tr]), y0, max(h_l, h_r)
 
 
 def _active(g: RackPinionGeometry, j: int, y_top: float, phis: np.ndarray) -> np.ndarray:
@@ -336,21 +345,41 @@ def tooth_pairs(g: RackPinionGeometry) -> list[tuple[int, int]]:
     return [(j, k) for j, ks in _tooth_pairs_by_pinion(g).items() for k in ks]
 
 
-def overlap_intervals(g: RackPinionGeometry, phis) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
+def _offsets(px, py, flat, inv_dy, slope_x, chain) -> tuple[np.ndarray, np.ndarray]:
+    """min and max over the chain's heights of [pinion boundary x(y) − chain x(y)], per angle
+    (rows of the pinion polygon's vertices px, py): over the pinion vertices within the chain's
+    heights and the pinion edges crossing the chain's vertex heights (±inf where none)."""
+    ys, xs = chain
+    inside = (py >= ys[0]) & (py <= ys[-1])
+    d = px - np.interp(py, ys, xs)
+    hi = np.where(inside, d, -np.inf).max(axis=1)
+    lo = np.where(inside, d, np.inf).min(axis=1)
+    for uy, ux in zip(ys, xs):
+        t = (uy - py) * inv_dy
+        crossing = ~flat & (t >= 0.0) & (t <= 1.0)
+        x = px + (uy - py) * slope_x
+        hi = np.maximum(hi, np.where(crossing, x, -np.inf).max(axis=1) - ux)
+        lo = np.minimum(lo, np.where(crossing, x, np.inf).min(axis=1) - ux)
+    return lo, hi
+
+
+def overlap_intervals(g: RackPinionGeometry, phis, flanks: bool = False):
     """For every pair (j, k) of :func:`tooth_pairs` and every pinion angle φ: the interval
     (lo, hi) of rack travels L at which rack tooth k overlaps pinion tooth j (NaN where their
     heights never overlap). Both teeth are convex, so hi = max over y of [pinion right edge(y)
     − rack left edge(y)] and lo = min over y of [pinion left edge(y) − rack right edge(y)],
     and the extremes lie at vertex heights of either polygon. L = hi: the pinion tooth touches
-    the left side of the rack tooth (towing drive side); L = lo: its right side."""
+    the left side of the rack tooth (towing drive side); L = lo: its right side.
+
+    With ``flanks`` the intervals are those of each flank segment alone (the faces that push
+    the rack): returns pairs, (lo, hi) of the left flanks and (lo, hi) of the right flanks; a
+    tooth in (lo, hi) of a left flank cuts it, and the rack clears it at L = hi (pushed +x)."""
     phis = np.atleast_1d(np.asarray(phis, dtype=float))
     pairs: list[tuple[int, int]] = []
-    los: list[np.ndarray] = []
-    his: list[np.ndarray] = []
+    rows: list[list[np.ndarray]] = []
     for j, ks in _tooth_pairs_by_pinion(g).items():
         chains = [_rack_chains(g, k) for k in ks]
-        y_top = max(c[4] for c in chains)
-        mask = _active(g, j, y_top, phis)
+        mask = _active(g, j, max(c[5] for c in chains), phis)
         idx = np.flatnonzero(mask)
         if idx.size:
             rho, gam = g.pinion_contact_polygon_polar(j)
@@ -364,37 +393,40 @@ def overlap_intervals(g: RackPinionGeometry, phis) -> tuple[list[tuple[int, int]
             inv_dy = 1.0 / np.where(flat, 1.0, dy)
             slope_x = (bx - px) * inv_dy
             y_min, y_max = py.min(axis=1), py.max(axis=1)
-        for k, ((ly, lx), (ry, rx), rack_pts, y0, top) in zip(ks, chains):
-            lo = np.full(phis.shape, np.nan)
-            hi = np.full(phis.shape, np.nan)
+        for k, (left, right, left_flank, right_flank, y0, top) in zip(ks, chains):
             pairs.append((j, k))
-            los.append(lo)
-            his.append(hi)
+            out = [np.full(phis.shape, np.nan) for _ in range(4 if flanks else 2)]
+            rows.append(out)
             if not idx.size:
                 continue
             overlap = (y_min <= top) & (y_max >= y0)
             if not overlap.any():
                 continue
-            # pinion vertices against the rack tooth's straight edges
-            inside = (py >= y0) & (py <= top)
-            hi_m = np.where(inside, px - np.interp(py, ly, lx), -np.inf).max(axis=1)
-            lo_m = np.where(inside, px - np.interp(py, ry, rx), np.inf).min(axis=1)
-            # rack vertices against the pinion tooth's edges
-            for ux, uy in rack_pts:
-                t = (uy - py) * inv_dy
-                crossing = ~flat & (t >= 0.0) & (t <= 1.0)
-                x = px + (uy - py) * slope_x
-                hi_m = np.maximum(hi_m, np.where(crossing, x, -np.inf).max(axis=1) - ux)
-                lo_m = np.minimum(lo_m, np.where(crossing, x, np.inf).min(axis=1) - ux)
-            ok = overlap & np.isfinite(hi_m) & np.isfinite(lo_m)
-            hi[idx[ok]] = hi_m[ok]
-            lo[idx[ok]] = lo_m[ok]
-    return pairs, np.array(los).reshape(len(pairs), phis.size), np.array(his).reshape(len(pairs), phis.size)
+            if flanks:
+                found = [_offsets(px, py, flat, inv_dy, slope_x, c) for c in (left_flank, right_flank)]
+            else:
+                found = [(_offsets(px, py, flat, inv_dy, slope_x, right)[0], _offsets(px, py, flat, inv_dy, slope_x, left)[1])]
+            for n, (lo_m, hi_m) in enumerate(found):
+                ok = overlap & np.isfinite(hi_m) & np.isfinite(lo_m)
+                out[2 * n][idx[ok]] = lo_m[ok]
+                out[2 * n + 1][idx[ok]] = hi_m[ok]
+    shape = (len(pairs), phis.size)
+    arrays = [np.array([r[n] for r in rows]).reshape(shape) for n in range(4 if flanks else 2)]
+    if flanks:
+        return pairs, (arrays[0], arrays[1]), (arrays[2], arrays[3])
+    return pairs, arrays[0], arrays[1]
 
 
-def pair_overlap_interval(g: RackPinionGeometry, j: int, k: int, phis) -> tuple[np.ndarray, np.ndarray]:
-    """(lo, hi) of :func:`overlap_intervals` for one pair."""
-    pairs, lo, hi = overlap_intervals(g, phis)
+def push_intervals(g: RackPinionGeometry, phis, direction: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
+    """(pairs, lo, hi) of the flanks that push the rack towards ``direction``: left flanks (+x),
+    right flanks (−x)."""
+    pairs, left, right = overlap_intervals(g, phis, flanks=True)
+    return (pairs, *left) if direction > 0 else (pairs, *right)
+
+
+def pair_push_interval(g: RackPinionGeometry, j: int, k: int, phis, direction: int) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) of :func:`push_intervals` for one pair."""
+    pairs, lo, hi = push_intervals(g, phis, direction)
     n = pairs.index((j, k))
     return lo[n], hi[n]
 
@@ -406,24 +438,39 @@ class Sweep:
     phi_rad: np.ndarray
     travel_mm: np.ndarray
     pairs: list[tuple[int, int]]
-    lo: np.ndarray  # (n_pairs, n_phi) overlap intervals, see pair_overlap_interval
+    lo: np.ndarray  # (n_pairs, n_phi) intervals of the pushing flanks, see push_intervals
     hi: np.ndarray
     direction: int  # +1: φ increasing, rack pushed +x; −1: φ decreasing, rack pushed −x
     max_overlap_mm: float  # deepest overlap left after the pushes (interference if > tolerance)
-    max_rate: float  # largest |ΔL/Δφ| between grid points, mm/rad (a jump would show as a jam)
+    max_rate: float  # largest |ΔL/Δφ| between grid points, mm/rad
+    overlap_mm: np.ndarray  # overlap depth at each angle (0: clear or touching)
 
     @property
     def phi_deg(self) -> np.ndarray:
         return np.degrees(self.phi_rad)
 
+    @property
+    def jammed(self) -> np.ndarray:
+        """Angles at which a tooth overlaps the rack it could not push (deeper than TRAVEL_TOL_MM)."""
+        return self.overlap_mm > TRAVEL_TOL_MM
 
-def _step(lo: np.ndarray, hi: np.ndarray, travel: float, direction: int) -> float:
-    inside = (lo < travel) & (travel < hi)
-    if direction > 0:
-        push = inside & (hi - travel < travel - lo)
-        return max(travel, float(hi[push].max())) if push.any() else travel
-    push = inside & (travel - lo < hi - travel)
-    return min(travel, float(lo[push].min())) if push.any() else travel
+
+def push_reach(g: RackPinionGeometry, step_rad: float) -> float:
+    """The farthest a tooth can drive the rack while the pinion turns by ``step_rad``."""
+    return PUSH_RATE_PER_TIP_RADIUS * g.tip_radius * abs(step_rad)
+
+
+def _step(lo: np.ndarray, hi: np.ndarray, travel: float, direction: int, reach: float = math.inf) -> float:
+    """Travel after a turn: the nearest travel towards ``direction`` at which no pushing flank
+    cuts a pinion tooth (``lo``, ``hi`` from :func:`push_intervals`), unless that takes more
+    than ``reach`` (a jam: the rack stays)."""
+    target = travel
+    while True:
+        cut = (lo < target) & (target < hi)
+        if not cut.any():
+            break
+        target = float(hi[cut].max()) if direction > 0 else float(lo[cut].min())
+    return target if abs(target - travel) <= reach else travel
 
 
 def _overlap_depth(lo: np.ndarray, hi: np.ndarray, travel: float) -> float:
@@ -433,27 +480,30 @@ def _overlap_depth(lo: np.ndarray, hi: np.ndarray, travel: float) -> float:
     return float(np.minimum(travel - lo[inside], hi[inside] - travel).max())
 
 
-def sweep(g: RackPinionGeometry, phis, travel_start: float, direction: int, intervals=None) -> Sweep:
+def sweep(g: RackPinionGeometry, phis, travel_start: float, direction: int) -> Sweep:
     """Swing the pinion through ``phis`` (monotone, in the sense of ``direction``) starting
     with the rack at ``travel_start``; at each angle the rack moves only as far as a pinion
-    tooth pushes it. ``intervals`` may pass precomputed :func:`overlap_intervals` at ``phis``."""
+    tooth pushes it through a flank, at most :func:`push_reach` per step (see
+    :data:`PUSH_NORMAL_MIN`); any overlap left (with the whole tooth) is interference."""
     phis = np.asarray(phis, dtype=float)
-    pairs, lo, hi = intervals if intervals is not None else overlap_intervals(g, phis)
+    pairs, lo, hi = push_intervals(g, phis, direction)
+    _, full_lo, full_hi = overlap_intervals(g, phis)
     travel = np.empty(phis.size)
+    depth = np.zeros(phis.size)
     current = float(travel_start)
-    depth = 0.0
     for i in range(phis.size):
-        current = _step(lo[:, i], hi[:, i], current, direction)
+        step = phis[i] - phis[i - 1] if i else 0.0
+        current = _step(lo[:, i], hi[:, i], current, direction, push_reach(g, step))
         travel[i] = current
-        depth = max(depth, _overlap_depth(lo[:, i], hi[:, i], current))
+        depth[i] = _overlap_depth(full_lo[:, i], full_hi[:, i], current)
     rate = float(np.max(np.abs(np.diff(travel) / np.diff(phis)))) if phis.size > 1 else 0.0
-    return Sweep(phis, travel, pairs, lo, hi, direction, depth, rate)
+    return Sweep(phis, travel, pairs, lo, hi, direction, float(depth.max()) if depth.size else 0.0, rate, depth)
 
 
-def _travel_after(g: RackPinionGeometry, phi: float, travel_before: float, direction: int) -> float:
-    """Rack travel at one angle, given where it was just before (for bisection)."""
-    _, lo, hi = overlap_intervals(g, [phi])
-    return _step(lo[:, 0], hi[:, 0], travel_before, direction)
+def _travel_after(g: RackPinionGeometry, phi: float, travel_before: float, direction: int, phi_before: float) -> float:
+    """Rack travel at one angle, given where it was at ``phi_before`` (for bisection)."""
+    _, lo, hi = push_intervals(g, [phi], direction)
+    return _step(lo[:, 0], hi[:, 0], travel_before, direction, push_reach(g, phi - phi_before))
 
 
 def _bisect(predicate, a: float, b: float) -> float:
@@ -500,7 +550,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
         i = int(np.argmax(fwd.travel_mm >= end - TRAVEL_TOL_MM))
         if i > 0:
             before = float(fwd.travel_mm[i - 1])
-            dis = _bisect(lambda p: _travel_after(g, p, before, +1) >= end - TRAVEL_TOL_MM, phis[i - 1], phis[i])
+            dis = _bisect(lambda p: _travel_after(g, p, before, +1, phis[i - 1]) >= end - TRAVEL_TOL_MM, phis[i - 1], phis[i])
         else:
             dis = float(phis[0])
         # the pair that pushed last, and where it stops touching
@@ -508,7 +558,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
         j, k = fwd.pairs[n]
 
         def apart(p: float) -> bool:
-            hi = pair_overlap_interval(g, j, k, [p])[1][0]
+            hi = pair_push_interval(g, j, k, [p], +1)[1][0]
             return not (np.isfinite(hi) and hi >= end - TRAVEL_TOL_MM)
 
         touching = np.isfinite(fwd.hi[n]) & (fwd.hi[n] >= end - TRAVEL_TOL_MM)
@@ -518,12 +568,12 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
             graze = _bisect(apart, phis[m - 1], phis[m])
 
     back_phis = phis[::-1]
-    back = sweep(g, back_phis, end, -1, (fwd.pairs, fwd.lo[:, ::-1], fwd.hi[:, ::-1]))
+    back = sweep(g, back_phis, end, -1)
     re = math.nan
     moved = back.travel_mm < end - TRAVEL_TOL_MM
     if moved.any():
         i = int(np.argmax(moved))
-        re = _bisect(lambda p: _travel_after(g, p, end, -1) < end - TRAVEL_TOL_MM, back_phis[i - 1], back_phis[i])
+        re = _bisect(lambda p: _travel_after(g, p, end, -1, back_phis[i - 1]) < end - TRAVEL_TOL_MM, back_phis[i - 1], back_phis[i])
     return Towing(fwd, back, dis, end if math.isfinite(dis) else math.nan, graze, re)
 
 

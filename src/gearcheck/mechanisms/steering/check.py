@@ -83,13 +83,14 @@ TRAVEL_BISECT_TOL_MM = 1e-4  # rack travel where a pushed rack just clears the p
 ANGLE_BISECT_TOL_RAD = 1e-8  # pinion angle where a driven pinion just clears the rack (1e-6 mm at r)
 EVENT_ANGLE_TOL_RAD = 1e-7  # disengage / grazing end / re-engage angles
 EVENT_TRAVEL_TOL_MM = 1e-5  # travel where the power-mode contact reaches S6
-# A wall faces along the travel when |n_x| exceeds this (flanks: cos 25° = 0.91; the trimmed
-# tops: 0.03, they cannot push the rack, and a contact with them shows as interference).
-FLANK_NORMAL_MIN = 0.5
-# Reach of one push: the largest pinion radius times the angle step, times this (a corner on a
-# steep flank can move the rack faster than r·φ), plus the contact tolerance (a pose that starts
-# in contact); sampled upwards in this many steps for the first free travel.
+# A rack triangle is a flank (the only faces that push the rack, see an.PUSH_NORMAL_MIN) when
+# its centroid lies within this of a flank segment of the drawing, in the section plane.
+FLANK_MATCH_MM = 1e-6
+# Reach of one towing push: the push model's bound (tip radius / PUSH_NORMAL_MIN per radian) times
+# the angle step, plus the contact tolerance (a pose that starts in contact). Power mode: the
+# rack turns the pinion at most REACH_MARGIN / (centre height − rack top) rad per mm.
 REACH_MARGIN = 1.5
+# A reach is sampled upwards in this many steps for the first free travel.
 REACH_SAMPLES = 16
 # Walls kept: the pinion's reaching within this of the rack's top (radius ≥ H − top − margin),
 # the rack's reaching within this of the pinion's tip circle.
@@ -98,8 +99,8 @@ WALL_REACH_MARGIN_MM = 1.0
 TANGENCY_WINDOW = 8
 
 PINION, RACK = "pinion", "rack"
-RACK_FACING_MINUS_X = "rack_facing_minus_x"  # left flanks: pushed by the pinion towards +x
-RACK_FACING_PLUS_X = "rack_facing_plus_x"  # right flanks: pushed towards −x, drive in power mode
+RACK_FACING_MINUS_X = "rack_left_flanks"  # facing −x: pushed by the pinion towards +x
+RACK_FACING_PLUS_X = "rack_right_flanks"  # facing +x: pushed towards −x, drive in power mode
 
 
 # =============================================================================================
@@ -121,9 +122,27 @@ def submesh(mesh: MeshData, name: str, keep: np.ndarray) -> MeshData:
     return MeshData(name, mesh.vertices[used], index[faces])
 
 
-def sweep_meshes(pinion: Body, rack: Body, centre_height_mm: float) -> tuple[list[MeshData], dict]:
+def rack_flank_faces(g, rack: MeshData) -> tuple[np.ndarray, np.ndarray]:
+    """Masks of the rack triangles on the left flanks (facing −x) and on the right flanks
+    (facing +x) of the drawing's teeth: matched by position, so that a trimmed top, however
+    slanted, never counts as a flank (the push model's rule)."""
+    centroid = rack.vertices[rack.faces].mean(axis=1)[:, :2]
+    left = np.zeros(len(rack.faces), bool)
+    right = np.zeros(len(rack.faces), bool)
+    for k in range(g.rack_first_tooth, g.rack_last_tooth + 1):
+        bl, br, tr, tl = g.rack_tooth_polygon(k, 0.0)
+        for a, b, mask in ((bl, tl, left), (br, tr, right)):
+            d = b - a
+            t = (centroid - a) @ d / float(d @ d)
+            rel = centroid - a
+            off = np.abs(d[0] * rel[:, 1] - d[1] * rel[:, 0]) / float(np.linalg.norm(d))
+            mask |= (t >= 0.0) & (t <= 1.0) & (off <= FLANK_MATCH_MM)
+    return left, right
+
+
+def sweep_meshes(g, pinion: Body, rack: Body, centre_height_mm: float) -> tuple[list[MeshData], dict]:
     """The meshes the sweep uses (own frames): pinion and rack side walls that can meet, and the
-    rack's walls split by the way they face along the travel. Also returns counts for the report."""
+    rack's left and right flanks apart (the faces that push). Also returns counts for the report."""
     zp, zr = pinion.mesh.vertices[:, 2], rack.mesh.vertices[:, 2]
     same_z = abs(zp.min() - zr.min()) < 1e-6 and abs(zp.max() - zr.max()) < 1e-6
     np_, nr = _normals(pinion.mesh), _normals(rack.mesh)
@@ -135,11 +154,12 @@ def sweep_meshes(pinion: Body, rack: Body, centre_height_mm: float) -> tuple[lis
     keep_p = walls_p & (radius >= reach)
     tip = float(radius.max())
     keep_r = walls_r & (rack.mesh.vertices[:, 1][rack.mesh.faces].max(axis=1) >= centre_height_mm - tip - WALL_REACH_MARGIN_MM)
+    left, right = rack_flank_faces(g, rack.mesh)
     meshes = [
         submesh(pinion.mesh, PINION, keep_p),
         submesh(rack.mesh, RACK, keep_r),
-        submesh(rack.mesh, RACK_FACING_MINUS_X, keep_r & (nr[:, 0] < -FLANK_NORMAL_MIN)),
-        submesh(rack.mesh, RACK_FACING_PLUS_X, keep_r & (nr[:, 0] > FLANK_NORMAL_MIN)),
+        submesh(rack.mesh, RACK_FACING_MINUS_X, keep_r & left),
+        submesh(rack.mesh, RACK_FACING_PLUS_X, keep_r & right),
     ]
     info = {"pinion_triangles_total": len(pinion.mesh.faces), "pinion_triangles_swept": int(keep_p.sum()),
             "rack_triangles_total": len(rack.mesh.faces), "rack_triangles_swept": int(keep_r.sum()),
@@ -603,7 +623,7 @@ def _prepare(params, bodies: dict[str, Body], towing_step_deg: float, power_step
     bound = pinion.error_bound_mm + rack.error_bound_mm
     kin = Kinematics.from_bodies(pinion, rack)
     centre_height = float(kin.pinion_origin[1])
-    meshes, mesh_info = sweep_meshes(pinion, rack, centre_height)
+    meshes, mesh_info = sweep_meshes(g, pinion, rack, centre_height)
     tip = float(np.hypot(pinion.mesh.vertices[:, 0], pinion.mesh.vertices[:, 1]).max())
     rack_top = float(rack.mesh.vertices[:, 1].max())
 
@@ -615,7 +635,7 @@ def _prepare(params, bodies: dict[str, Body], towing_step_deg: float, power_step
         raise ValueError("the rack mesh has no vertex at the S6 corner of the drawing")
     nr = _normals(rack.mesh)
     touches = np.any(np.hypot(rv[rf][..., 0] - corner[0], rv[rf][..., 1] - corner[1]) < 1e-6, axis=1)
-    facing = np.flatnonzero(touches & (nr[:, 0] > FLANK_NORMAL_MIN))
+    facing = np.flatnonzero(touches & rack_flank_faces(g, rack.mesh)[1])
     a = g.pressure_angle_rad
     normal = nr[facing[0], :2] / np.linalg.norm(nr[facing[0], :2]) if facing.size else np.array([math.cos(a), math.sin(a)])
     up = np.array([-normal[1], normal[0]])
@@ -629,7 +649,7 @@ def _prepare(params, bodies: dict[str, Body], towing_step_deg: float, power_step
     return _Setup(
         g=g, kin=kin, meshes=meshes, mesh_info=mesh_info, bound=bound, tol=max(CONTACT_TOL_MM, bound),
         limit=0.5 * g.pitch, angles=angles, travels=np.linspace(0.0, stroke, n_power + 1),
-        reach_travel_per_rad=tip * REACH_MARGIN, reach_angle_per_mm=REACH_MARGIN / (centre_height - rack_top),
+        reach_travel_per_rad=tip * an.PUSH_RATE_PER_TIP_RADIUS, reach_angle_per_mm=REACH_MARGIN / (centre_height - rack_top),
         profile=pinion_profile(pinion.mesh), corner=corner, normal=normal, up=up,
     )
 
