@@ -65,20 +65,25 @@ def sweep_sample(loaded: Loaded, parts: list) -> dict | None:
 
     from gearcheck.cad.export import export_parts, sweep_bodies
 
+    from gearcheck.sweep import resolution
+
+    tol = loaded.module.MESH_TOL_MM  # the check's default, as `gearcheck check` meshes
     with tempfile.TemporaryDirectory() as tmp:
         _, exported = export_parts(parts, Path(tmp), name="fuzz", mechanism=loaded.mechanism,
-                                   params_data=loaded.resolved_data)
+                                   params_data=loaded.resolved_data, tol_mm=tol)
     bodies = sweep_bodies(exported)
     kwargs = {}
     if loaded.mechanism == "differential":
         kwargs = {"angles_per_cycle": FUZZ_DIFFERENTIAL_ANGLES, "shims_mm": [loaded.params.shim.thickness_mm]}
     result = loaded.check_module.run_check(loaded.params, bodies, **kwargs)
+    resolution.enforce(result, bodies, tol, "fuzz")  # ParamError: rejected after meshing
     verdicts = {v.key: int(v.passed) for v in result.verdicts}
     broken = [k for k in CONSISTENCY_VERDICTS if verdicts.get(k) == 0]
     if broken:
         details = "; ".join(v.detail for v in result.verdicts if v.key in broken)
         raise AssertionError(f"mesh sweep disagrees with the exact model: {details}")
-    return {"verdicts": verdicts, "verdict_pass": int(result.passed)}
+    return {"verdicts": verdicts, "verdict_pass": int(result.passed),
+            "mesh_resolution": resolution.resolution_summary(result, bodies)}
 
 
 def _reason(exc: ParamError) -> str:
@@ -94,12 +99,12 @@ def _lookup(body: dict, field: str):
     return node
 
 
-def check_rejection(body: dict, exc: ParamError) -> str | None:
+def check_rejection(body: dict, exc: ParamError, source: str = "fuzz") -> str | None:
     """What is wrong with a rejection message, or None."""
     text = str(exc)
     if "\n" in text:
         return "message is more than one line"
-    if not exc.field or not text.startswith(f"fuzz: {exc.field} = "):
+    if not exc.field or not text.startswith(f"{source}: {exc.field} = "):
         return "message does not name a field"
     if "allowed" not in exc.allowed:
         return "message gives no allowed range"
@@ -148,7 +153,8 @@ def check_parts(parts) -> tuple[str | None, dict]:
 def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -> dict:
     module = mechanism_module(mech)
     base = load_template(TEMPLATES[mech]).data
-    stats = {"tried": 0, "accepted": 0, "rejected": 0, "calc_ok": 0, "cad_built": 0, "cad_ok": 0}
+    stats = {"tried": 0, "accepted": 0, "rejected": 0, "calc_ok": 0, "cad_built": 0, "cad_ok": 0,
+             "swept": 0, "rejected_after_meshing": 0}
     fields, reasons, nan_figures = collections.Counter(), collections.Counter(), collections.Counter()
     failures, swept = [], []
     timing = {"validate_s": 0.0, "calc_s": 0.0, "cad_s": 0.0}
@@ -213,9 +219,18 @@ def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -
         loaded = Loaded(path=Path(f"fuzz/{mech}-{set_seed}.toml"), mechanism=mech, params=params, data=data)
         try:
             result = sweep_sample(loaded, parts)
+        except ParamError as exc:  # the mesh-resolution rule: a clear rejection, not a failure
+            stats["rejected_after_meshing"] += 1
+            problem = check_rejection({"--tol": 0}, exc, source="fuzz")
+            if problem:
+                fail("mesh-rule", set_seed, data, f"{problem}: {exc}")
+            else:
+                reasons[_reason(exc)] += 1
+            continue
         except Exception:
             fail("sweep", set_seed, data, traceback.format_exc())
             continue
+        stats["swept"] += 1
         if result is not None:
             swept.append({"seed": set_seed, "build": built, "sweep": result})
         log(f"  {mech} CAD {stats['cad_built']}/{cad} seed {set_seed}: {built['parts']} parts, "
@@ -256,15 +271,16 @@ def main(argv: list[str] | None = None) -> int:
     elapsed = time.perf_counter() - t_start
 
     totals = {k: sum(r[k] for r in results.values())
-              for k in ("tried", "accepted", "rejected", "calc_ok", "cad_built", "cad_ok")}
+              for k in ("tried", "accepted", "rejected", "calc_ok", "cad_built", "cad_ok", "swept",
+                        "rejected_after_meshing")}
     failures = [f for r in results.values() for f in r["failures"]]
     print()
-    print(f"{'mechanism':<14}{'tried':>7}{'accepted':>10}{'rejected':>10}{'calc ok':>9}{'CAD ok':>9}{'failed':>8}{'time s':>8}")
-    for mech, r in results.items():
+    print(f"{'mechanism':<14}{'tried':>7}{'accepted':>10}{'rejected':>10}{'calc ok':>9}{'CAD ok':>9}"
+          f"{'swept':>7}{'mesh rej':>9}{'failed':>8}{'time s':>8}")
+    for mech, r in [*results.items(), ("total", {**totals, "failures": failures, "elapsed_s": round(elapsed, 1)})]:
         print(f"{mech:<14}{r['tried']:>7}{r['accepted']:>10}{r['rejected']:>10}{r['calc_ok']:>9}"
-              f"{r['cad_ok']:>5}/{r['cad_built']:<3}{len(r['failures']):>8}{r['elapsed_s']:>8}")
-    print(f"{'total':<14}{totals['tried']:>7}{totals['accepted']:>10}{totals['rejected']:>10}{totals['calc_ok']:>9}"
-          f"{totals['cad_ok']:>5}/{totals['cad_built']:<3}{len(failures):>8}{elapsed:>8.1f}")
+              f"{r['cad_ok']:>5}/{r['cad_built']:<3}{r['swept']:>7}{r['rejected_after_meshing']:>9}"
+              f"{len(r['failures']):>8}{r['elapsed_s']:>8}")
     for mech, r in results.items():
         print(f"\n{mech}: rejection reasons (top 12 of {len(r['rejection_reasons'])})")
         for reason, n in list(r["rejection_reasons"].items())[:12]:

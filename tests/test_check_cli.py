@@ -47,3 +47,23 @@ def test_failing_verdict_exits_1(tmp_path, templates_dir):
     summary = json.loads((tmp_path / "summary.json").read_text())["track"]
     assert summary["verdict_pass"] == 0
     assert summary["verdicts"]["seated_tip_gap_in_window"] == 0
+
+
+def test_meshes_too_coarse_for_the_clearance_are_rejected(first_run, tmp_path, templates_dir, capsys):
+    """Issue 11: after meshing, a mesh-error bound above 1/10 of the smallest clearance checked
+    (track: tooth–sleeve 0.100 mm) is a one-line --tol error, exit 2, and no report is left —
+    not even one from an earlier run in the same folder."""
+    _, out = first_run
+    for name in ("summary.json", "sweep.csv", "report.html"):
+        (tmp_path / name).write_bytes((out / name).read_bytes())
+    code = main(["check", str(templates_dir / "eod_track_drive.toml"), "--tol", "0.02", "--out", str(tmp_path)])
+    assert code == 2
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert "--tol = 0.02: allowed ≤ 0.009999 mm" in err and "tooth–sleeve" in err
+    for name in ("summary.json", "sweep.csv", "report.html"):
+        assert not (tmp_path / name).exists(), name
+    # the default run records the rule it met
+    summary = json.loads((out / "summary.json").read_text())["track"]["mesh_resolution"]
+    assert summary["rule_met"] == 1
+    assert summary["mesh_error_bound_mm"] <= summary["allowed_bound_mm"] == pytest.approx(0.1 * summary["smallest_clearance_mm"])
+    assert summary["smallest_clearance_mm"] == pytest.approx(0.1, abs=1e-3)

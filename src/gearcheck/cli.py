@@ -56,7 +56,9 @@ def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default out/NAME; with --all, the parent folder, default out)")
     p.add_argument("--tol", type=float, default=None, metavar="MM",
-                   help="absolute chordal tolerance of the meshes in mm (default 0.01)")
+                   help="absolute chordal tolerance of the meshes in mm (default per mechanism: differential "
+                        "0.003, track 0.008, steering 0.01 — fine enough that the mesh-error bound is at most "
+                        "1/10 of the smallest clearance the check decides on; `check` refuses coarser meshes)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -172,11 +174,19 @@ def _check_one(loaded, folder: Path, tol_mm: float | None) -> bool:
     from gearcheck.output import atomic_write_text
     from gearcheck.report.files import summary_json, sweep_csv
     from gearcheck.report.html import render
+    from gearcheck.sweep import resolution
 
+    # the report files of an earlier run would describe other meshes: gone until this run writes its own
+    for stale in ("summary.json", "sweep.csv", "report.html"):
+        (folder / stale).unlink(missing_ok=True)
     manifest, exported = _build_one(loaded, folder, tol_mm)
     bodies = sweep_bodies(exported)
     with tqdm(desc=f"sweeping {loaded.name}", unit="pose", file=sys.stderr, disable=not sys.stderr.isatty()) as bar:
         result = loaded.check_module.run_check(loaded.params, bodies, progress=bar.update)
+    # after meshing, not before: the bound is measured on the meshes, the clearance by the check
+    resolution.enforce(result, bodies, mesh_tol(loaded, tol_mm), str(loaded.path))
+    result.summary["mesh_resolution"] = resolution.resolution_summary(result, bodies)
+    result.notes.append(resolution.describe(result, bodies))
     parts = {e.part.name: e.part for e in exported}
     confirmations = {}
     for worst in tqdm(result.worst_poses, desc="exact B-rep distance at worst poses", file=sys.stderr,
@@ -242,7 +252,6 @@ def _build_one(loaded, folder: Path, tol_mm: float | None):
     from tqdm import tqdm
 
     from gearcheck.cad.export import export_parts
-    from gearcheck.cad.mesh import CHORDAL_TOL_MM
 
     print(f"building {loaded.name} ({loaded.mechanism}) ...", file=sys.stderr)
     parts = loaded.parts_module.build_parts(loaded.params)
@@ -250,11 +259,16 @@ def _build_one(loaded, folder: Path, tol_mm: float | None):
               disable=not sys.stderr.isatty()) as bar:
         manifest, exported = export_parts(
             parts, folder, name=loaded.name, mechanism=loaded.mechanism, params_data=loaded.resolved_data,
-            tol_mm=tol_mm if tol_mm is not None else CHORDAL_TOL_MM,
+            tol_mm=mesh_tol(loaded, tol_mm),
             progress=lambda _name: bar.update(1),
         )
     print(f"wrote {folder}/ : {len(parts)} parts, {manifest['step']['file']}, manifest.json")
     return manifest, exported
+
+
+def mesh_tol(loaded, tol_mm: float | None) -> float:
+    """--tol, or the mechanism's default (fine enough for the template's smallest clearance)."""
+    return tol_mm if tol_mm is not None else loaded.module.MESH_TOL_MM
 
 
 def _check_tol(tol: float | None) -> None:

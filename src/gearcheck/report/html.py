@@ -25,6 +25,7 @@ th, td { border: 1px solid #d6d9e0; padding: 0.3em 0.6em; text-align: left; vert
 th { background: #f2f4f8; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
 td.ok { color: #17612a; font-weight: 600; } td.bad { color: #8a1c1c; font-weight: 600; }
 .meta { color: #5a6275; font-size: 0.9em; } .plot { margin: 1em 0; }
+.key { font-size: 0.82em; color: #3a4255; margin: 0.2em 0 0 4em; max-width: 60em; }
 .notes li { margin: 0.3em 0; } code { background: #f2f4f8; padding: 0 0.25em; }
 """
 
@@ -43,6 +44,24 @@ def _fmt(x, digits: int = 4) -> str:
     return html.escape(str(x))
 
 
+# Neighbouring marker tags closer than this fraction of the x range go on the next row.
+MARKER_TAG_SPACING = 0.03
+HLINE_COLOURS = ["#b03030", "#7a3db8", "#2f7d32", "#b8860b"]
+
+
+def _sorted_markers(plot: Plot) -> list[tuple[str, float]]:
+    return sorted(plot.markers, key=lambda m: m[1])
+
+
+def marker_key(plot: Plot) -> str:
+    """The numbered markers' names under the plot (HTML)."""
+    if not plot.markers:
+        return ""
+    items = " · ".join(f"<b>{n}</b> {html.escape(label)} ({x:.4g})"
+                       for n, (label, x) in enumerate(_sorted_markers(plot), start=1))
+    return f"<p class='key'>{items}</p>"
+
+
 def plot_svg(plot: Plot) -> str:
     """One plot as inline SVG (matplotlib, Agg backend, no timestamp metadata)."""
     import matplotlib
@@ -57,20 +76,26 @@ def plot_svg(plot: Plot) -> str:
             ax.plot(s.x, s.y, "o", ms=3.5, label=s.label)
         else:
             ax.plot(s.x, s.y, "-", lw=1.6, label=s.label)
-    for i, (label, x) in enumerate(sorted(plot.markers, key=lambda m: m[1])):
+    # Event markers: numbered tags on the lines (the key under the plot names them), tags of
+    # neighbouring events (a fraction of a degree apart) stepped down so none overlap.
+    span = max((max(s.x) - min(s.x) for s in plot.series if s.x), default=1.0) or 1.0
+    last_x: list[float] = []  # per tag row, the x of its last tag
+    for number, (_label, x) in enumerate(_sorted_markers(plot), start=1):
         ax.axvline(x, ls="--", lw=1.0, color="0.35")
-        # neighbouring markers (events a fraction of a degree apart) get staggered labels
-        ax.annotate(label, (x, 0.98 - 0.3 * (i % 3)), xycoords=("data", "axes fraction"), rotation=90,
-                    fontsize=7, va="top", ha="right", color="0.25")
-    for label, y in plot.hlines:
-        ax.axhline(y, ls=":", lw=1.2, color="#b03030")
-        ax.annotate(label, (0.0, y), xycoords=("axes fraction", "data"), fontsize=8, va="bottom",
-                    color="#b03030")
+        row = next((r for r, lx in enumerate(last_x) if x - lx >= MARKER_TAG_SPACING * span), len(last_x))
+        last_x[row:row + 1] = [x]
+        ax.annotate(str(number), (x, 0.97 - 0.08 * row), xycoords=("data", "axes fraction"), fontsize=7,
+                    ha="center", va="top", color="0.15",
+                    bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "0.45", "lw": 0.6})
+    # Horizontal reference lines go into the legend (labels at the axis edge collide).
+    for (label, y), colour in zip(plot.hlines, HLINE_COLOURS * (1 + len(plot.hlines) // len(HLINE_COLOURS))):
+        shown = label if any(c.isdigit() for c in label) else f"{label} ({y:g})"  # the value once
+        ax.axhline(y, ls=":", lw=1.3, color=colour, label=shown)
     ax.set_title(plot.title, fontsize=11)
     ax.set_xlabel(plot.xlabel)
     ax.set_ylabel(plot.ylabel)
     ax.grid(True, alpha=0.3)
-    if plot.series:
+    if plot.series or plot.hlines:
         ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     buf = io.StringIO()
@@ -125,7 +150,7 @@ def render(result: CheckResult, *, title: str, template: str, build: dict, confi
     if result.plots:
         parts.append("<h2>Plots</h2>")
         for plot in result.plots:
-            parts.append(f"<div class='plot'>{plot_svg(plot)}</div>")
+            parts.append(f"<div class='plot'>{plot_svg(plot)}{marker_key(plot)}</div>")
 
     if result.notes:
         parts.append("<h2>Findings</h2><ul class='notes'>")

@@ -76,6 +76,15 @@ class WorstPose:
         return "_".join(filter(None, slug.split("_")))[:80]
 
 
+@dataclass(frozen=True)
+class Clearance:
+    """The smallest non-zero clearance a check decides a verdict on (from its exact model, not
+    the mesh), for the mesh-resolution rule (:mod:`gearcheck.sweep.resolution`)."""
+
+    value_mm: float
+    label: str  # what it is, with the figure in the check's own units
+
+
 @dataclass
 class CheckResult:
     """Everything one mechanism's check produced."""
@@ -91,6 +100,8 @@ class CheckResult:
     # wall-clock figures (s, poses/s): for benchmarks and the terminal, never in summary.json,
     # which must be byte-identical between runs
     timings: dict = field(default_factory=dict)
+    # None: the mechanism checks no non-zero clearance (zero-backlash contact)
+    smallest_clearance: Clearance | None = None
 
     @property
     def passed(self) -> bool:

@@ -15,6 +15,9 @@ from gearcheck.mechanisms.differential import analysis
 from gearcheck.mechanisms.differential.params import Params, shim_key
 
 SECTION = "differential"
+# Meshing tolerance when --tol is not given: the mesh-error bound must stay within 1/10 of the
+# least play checked (template: 2.98′ per side cold = 35.8 µm on d1/2, so ≤ 3.6 µm).
+MESH_TOL_MM = 0.003
 
 # The paper's printed values (report data only, never used in a computation).
 PAPER = {

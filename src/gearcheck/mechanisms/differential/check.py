@@ -58,7 +58,7 @@ from gearcheck.mechanisms.differential.poses import assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, GearThermal, thermal_state
 from gearcheck.sweep.engine import Body, MeshData, Scene, bisect_contact
 from gearcheck.sweep.pool import default_workers, map_scene
-from gearcheck.sweep.result import CheckResult, Comparison, Plot, Series, Verdict, WorstPose
+from gearcheck.sweep.result import CheckResult, Clearance, Comparison, Plot, Series, Verdict, WorstPose
 
 SECTION = "differential"
 
@@ -588,7 +588,21 @@ def _assemble(params, specs, bodies, thermal, shims, template_shim, angles, by_k
             "binds cold (negative: overlap as an angle)" if geom_min[z, C] <= 0 else "", float(exact_min[z, C])))
 
     notes = _notes(shims, t, geom_min, summary, specs, angles, bound_arcmin, speed)
-    return CheckResult(SECTION, summary, verdicts, rows, comparisons, plots, notes, worst)
+    return CheckResult(SECTION, summary, verdicts, rows, comparisons, plots, notes, worst,
+                       smallest_clearance=smallest_clearance(specs, shims[t], exact_min[t, W], exact_min[t, C]))
+
+
+def smallest_clearance(specs, shim_mm: float, warm_arcmin: float, cold_arcmin: float) -> Clearance | None:
+    """The least positive play per side at the template's shim (exact flanks, warm or cold) as the
+    arc it spans on the big gear's outer pitch circle: the radius the check converts its mesh
+    bound with, so the rule reads bound ≤ play/10 in the verdicts' own terms."""
+    plays = [(v, state) for v, state in ((cold_arcmin, "cold"), (warm_arcmin, "warm")) if v > 0.0]
+    if not plays:
+        return None
+    play, state = min(plays)
+    d1_half = specs.big.outer_pitch_diameter_mm / 2.0
+    return Clearance(float(play) / bp.ARCMIN_PER_RAD * d1_half,
+                     f"least {state} play per side at shim {shim_mm:.2f} mm (exact flanks, {play:.3f}′ on d1/2)")
 
 
 def _worst_poses(bodies, specs, thermal, shim, template_shim, phi, big, small, direction, rec) -> list[WorstPose]:

@@ -14,6 +14,9 @@ from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.mechanisms.steering.params import Params
 
 SECTION = "steering"
+# Meshing tolerance when --tol is not given. Zero backlash: no non-zero clearance is checked,
+# contact is decided within the sum of the two meshes' bounds (0.02 mm at this tolerance).
+MESH_TOL_MM = 0.01
 
 __all__ = ["SECTION", "Params", "calc"]
 

@@ -15,6 +15,9 @@ from gearcheck.mechanisms.track import analysis
 from gearcheck.mechanisms.track.params import Params
 
 SECTION = "track"
+# Meshing tolerance when --tol is not given: the mesh-error bound must stay within 1/10 of the
+# least clearance checked (template: tooth–sleeve 0.100 mm, so ≤ 0.010 mm; 20 % margin).
+MESH_TOL_MM = 0.008
 
 # The paper's printed values (data for the report, never used in the model).
 PAPER = {

@@ -39,7 +39,7 @@ from gearcheck.geometry import track_chain as tc
 from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis, layout
 from gearcheck.sweep.engine import Body, MeshData, Scene, bisect_contact
 from gearcheck.sweep.pool import map_scene
-from gearcheck.sweep.result import CheckResult, Comparison, Plot, Series, Verdict, WorstPose
+from gearcheck.sweep.result import CheckResult, Clearance, Comparison, Plot, Series, Verdict, WorstPose
 
 SECTION = "track"
 
@@ -697,4 +697,8 @@ def run_check(params, bodies: dict[str, Body], progress: Callable[[int], None] |
     ]
     timings = {"sweep_s": sweep_s, "poses_per_s": n_poses / sweep_s,
                "link_poses_per_s": n_poses * wrap.links / sweep_s, "contact_proof_s": proof_s}
-    return CheckResult(SECTION, summary, verdicts, rows, comparisons, plots, notes, worst, timings)
+    clearances = [(v, what) for v, what in ((ex_min_sleeve.value, "least tooth–sleeve clearance"),
+                                            (ex_min_plate.value, "least tip-to-plate distance")) if v > 0.0]
+    least = min(clearances) if clearances else None
+    clearance = Clearance(float(least[0]), f"{least[1]} (exact 2-D)") if least else None
+    return CheckResult(SECTION, summary, verdicts, rows, comparisons, plots, notes, worst, timings, clearance)
