@@ -7,13 +7,18 @@ paper's analytical model with finite figures (NaN only where documented). The fi
 of each mechanism are then built (build_parts), every solid checked valid and meshed at 0.02 mm
 (watertight, volume within the mesh's error bound) — and handed to :func:`sweep_sample`.
 
-Prints tried / accepted / rejected per mechanism and the rejection reasons, writes out/fuzz.json
-(counts, histograms, timings and every failure with the set that caused it, to reproduce), and
-exits 1 if anything failed. Defaults: 1200 sets per mechanism (3600 validated, ~1100 accepted and
-run through the analytical models), 35 CAD builds per mechanism (105), each built set then swept
-(FCL, its mechanism's check; the differential at 4 drive angles and its own shim). Measured
-before the sweeps: 3300 sets + 105 builds in 410 s; a sweep adds ~5–12 s per set (6 sets in a
-58 s small run); measured full run: 1,040 s on the 2-core machine. --sets/--cad scale it; --only picks mechanisms.
+Each built set is then swept at its mechanism's default meshing tolerance (as `gearcheck check`
+meshes: differential 0.003 mm, track 0.008, steering 0.01) with its mechanism's check (the
+differential at 4 drive angles and its own shim), and the mesh-resolution rule applied: a set
+whose smallest clearance checked is below 10× the mesh-error bound is *rejected after meshing*
+(one --tol line, counted apart, not a failure). A failure is: a rejection message that is not one
+line naming a field and a range, a calc/CAD/sweep exception, or a consistency verdict (mesh
+sweep vs the independent exact model) that does not hold.
+
+Prints tried / accepted / rejected / swept per mechanism and the rejection reasons, writes
+out/fuzz.json (counts, histograms, timings and every failure with the set that caused it, to
+reproduce), and exits 1 if anything failed. Defaults: 1200 sets per mechanism, 35 CAD builds and
+sweeps per mechanism (105). --sets/--cad scale it; --only picks mechanisms.
 """
 
 from __future__ import annotations

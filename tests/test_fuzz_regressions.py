@@ -102,6 +102,15 @@ def test_a_slanted_top_never_pushes_the_rack():
     assert t.back.max_rate <= an.PUSH_RATE_PER_TIP_RADIUS * g.tip_radius * (1 + 1e-9)
 
 
+def test_paper_figures_only_for_the_papers_design(templates_dir):
+    from gearcheck.mechanisms import load_template
+    from gearcheck.mechanisms.steering.check import paper_figures
+
+    template = load_template(templates_dir / "nose_wheel_steering.toml").params
+    assert paper_figures(template)["disengage_deg"] == an.PAPER["disengage_deg"]
+    assert set(paper_figures(params_of("steering", STEERING_SEED_2000084)).values()) == {None}
+
+
 # --- mesh sweep against the model (CAD) ------------------------------------------------------
 
 def _swept(mech: str, body: dict, **kwargs):
@@ -134,3 +143,6 @@ def test_slanted_tops_mesh_towing_curve_agrees(body, jams):
     assert verdicts["towing_curve"].passed, verdicts["towing_curve"].detail
     # the jam is a design failure both ways agree on, shown as interference on the return swing
     assert verdicts["no_interference_reengage"].passed is (not jams), verdicts["no_interference_reengage"].detail
+    # another design than the paper's: no printed figure is shown beside it as if it were a target
+    assert all(c.paper is None for c in result.comparisons)
+    assert not any("paper" in label for plot in result.plots for label, x in plot.markers if x is not None)

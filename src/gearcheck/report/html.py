@@ -50,12 +50,13 @@ HLINE_COLOURS = ["#b03030", "#7a3db8", "#2f7d32", "#b8860b"]
 
 
 def _sorted_markers(plot: Plot) -> list[tuple[str, float]]:
-    return sorted(plot.markers, key=lambda m: m[1])
+    """Markers with a value (a figure that does not apply is None), by position."""
+    return sorted(((label, x) for label, x in plot.markers if x is not None and math.isfinite(x)), key=lambda m: m[1])
 
 
 def marker_key(plot: Plot) -> str:
     """The numbered markers' names under the plot (HTML)."""
-    if not plot.markers:
+    if not _sorted_markers(plot):
         return ""
     items = " · ".join(f"<b>{n}</b> {html.escape(label)} ({x:.4g})"
                        for n, (label, x) in enumerate(_sorted_markers(plot), start=1))
@@ -88,14 +89,15 @@ def plot_svg(plot: Plot) -> str:
                     ha="center", va="top", color="0.15",
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "0.45", "lw": 0.6})
     # Horizontal reference lines go into the legend (labels at the axis edge collide).
-    for (label, y), colour in zip(plot.hlines, HLINE_COLOURS * (1 + len(plot.hlines) // len(HLINE_COLOURS))):
+    hlines = [(label, y) for label, y in plot.hlines if y is not None and math.isfinite(y)]
+    for (label, y), colour in zip(hlines, HLINE_COLOURS * (1 + len(hlines) // len(HLINE_COLOURS))):
         shown = label if any(c.isdigit() for c in label) else f"{label} ({y:g})"  # the value once
         ax.axhline(y, ls=":", lw=1.3, color=colour, label=shown)
     ax.set_title(plot.title, fontsize=11)
     ax.set_xlabel(plot.xlabel)
     ax.set_ylabel(plot.ylabel)
     ax.grid(True, alpha=0.3)
-    if plot.series or plot.hlines:
+    if plot.series or hlines:
         ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     buf = io.StringIO()

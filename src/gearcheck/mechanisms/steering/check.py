@@ -1,10 +1,12 @@
 """Steering sweeps with FCL on the built meshes (seed 003, issue 10): towing and power mode.
 
 **Towing** (the pinion drives): the pinion turns 0 → ±max → 0. At each angle the rack moves only
-as far as a tooth pushes it: if the rack faces that a tooth can push (those facing against the
-push) collide at the rack's previous travel, the rack advances by the smallest amount that clears
-them (bisection on the travel between a colliding and a free travel: contact proven from both
-sides); otherwise it stands. On the return swing the other flanks push it back the same way.
+as far as a tooth pushes it: if the rack flanks that a tooth can push (those facing against the
+push; a trimmed top never pushes, the push model's rule) collide at the rack's previous travel,
+the rack advances by the smallest amount that clears them, at most the model's push reach
+(bisection on the travel between a colliding and a free travel: contact proven from both sides);
+otherwise it stands, and a jam shows as interference. On the return swing the other flanks push
+it back the same way.
 This gives the towing curve L(φ), compared pose by pose with the exact-polyline push model
 (:func:`analysis.sweep`). Events, each by bisection between grid poses:
 
@@ -777,8 +779,16 @@ def _verdicts(params, plus: dict, minus: dict, model: _Model, tol: float, poses:
     ]
 
 
-def _comparisons(plus: dict, model: _Model, travel_at_adams: float, max_dev: float) -> list[Comparison]:
-    P = an.PAPER
+def paper_figures(params) -> dict:
+    """The paper's figures when the template is the paper's mechanism (m 4, z 42, α 25°, H 107),
+    else all None: a printed angle beside another design's result would read as a target."""
+    p = params.pinion
+    same = (math.isclose(p.module_mm, 4.0) and p.teeth == 42 and math.isclose(p.pressure_angle_deg, 25.0)
+            and math.isclose(params.layout.centre_to_datum_mm, 107.0))
+    return dict(an.PAPER) if same else dict.fromkeys(an.PAPER)
+
+
+def _comparisons(P: dict, plus: dict, model: _Model, travel_at_adams: float, max_dev: float) -> list[Comparison]:
     dis, stand, cont = plus["geom_disengage_angle_deg"], plus["geom_rack_travel_at_disengage_mm"], plus["geom_continuous_angle_deg"]
     return [
         Comparison("disengage angle (rack stops), theory", "deg", P["disengage_deg"], model.disengage_deg, dis,
@@ -809,8 +819,7 @@ def _comparisons(plus: dict, model: _Model, travel_at_adams: float, max_dev: flo
     ]
 
 
-def _plots(tow: dict, power: dict, curves: dict, plus: dict, model: _Model) -> list[Plot]:
-    P = an.PAPER
+def _plots(P: dict, tow: dict, power: dict, curves: dict, plus: dict, model: _Model) -> list[Plot]:
     dis, stand = plus["geom_disengage_angle_deg"], plus["geom_rack_travel_at_disengage_mm"]
     out, back = np.degrees(tow[1]["angles_out"]), np.degrees(tow[1]["angles_back"])
     stops = [("mesh stop", dis), ("model stop", model.disengage_deg), ("paper theory", P["disengage_deg"]),
@@ -850,15 +859,16 @@ def _plots(tow: dict, power: dict, curves: dict, plus: dict, model: _Model) -> l
     ]
 
 
-def _notes(su: _Setup, plus: dict, minus: dict, model: _Model, speed: dict) -> list[str]:
-    P = an.PAPER
+def _notes(P: dict, su: _Setup, plus: dict, minus: dict, model: _Model, speed: dict) -> list[str]:
+    printed = (f"; paper {P['disengage_deg']}°/{P['travel_disengage_mm']} theory, {P['adams_disengage_deg']}°/"
+               f"{P['adams_travel_mm']} ADAMS, {P['test_disengage_deg']:g}°/{P['test_travel_mm']} test"
+               if P["disengage_deg"] is not None else "")
     return [
         f"Contact tolerance {su.tol:.3f} mm (≥ the meshes' error bound {su.bound:.3f} mm): zero-backlash flanks touch at "
         "zero clearance, so a collision is measured (the rack shift that clears it) and accepted up to this depth.",
         f"Towing: the rack stops at +{plus['geom_disengage_angle_deg']:.3f}° / −{minus['geom_disengage_angle_deg']:.3f}° "
-        f"at {plus['geom_rack_travel_at_disengage_mm']:.3f} mm (model {model.disengage_deg:.3f}°, {model.stand_mm:.3f} mm; "
-        f"paper {P['disengage_deg']}°/{P['travel_disengage_mm']} theory, {P['adams_disengage_deg']}°/{P['adams_travel_mm']} ADAMS, "
-        f"{P['test_disengage_deg']:g}°/{P['test_travel_mm']} test).",
+        f"at {plus['geom_rack_travel_at_disengage_mm']:.3f} mm (model {model.disengage_deg:.3f}°, {model.stand_mm:.3f} mm"
+        f"{printed}).",
         f"Past the stop G1's tip land grazes S2 (closest {plus['graze_distance_mm']:.2e} mm at {plus['graze_angle_deg']:.2f}°; "
         f"the rack reaches contact {plus['graze_contact_shift_mm']:.5f} mm further back) for {plus['geom_grazing_span_deg']:.2f}° "
         f"(model {model.graze_deg:.2f}°); the standing rack creeps ≤ {plus['geom_rack_motion_after_disengage_mm']:.4f} mm as "
@@ -882,6 +892,7 @@ def run_check(params, bodies: dict[str, Body], progress=None, *, towing_step_deg
     angle 0 / travel 0, motions: rotation about the pinion axis, translation along the rack)."""
     t_start = time.perf_counter()
     P = an.PAPER
+    paper = paper_figures(params)
     g = an.geometry_from_params(params)
     tow_model = an.analyse_towing(g, params.towing.max_angle_deg, extra_deg=an.CHECK_ANGLES_DEG + (P["adams_disengage_deg"],))
     model = _Model.of(g, tow_model)
@@ -938,8 +949,8 @@ def run_check(params, bodies: dict[str, Body], progress=None, *, towing_step_deg
         for d in (+1, -1) if (w := tow[d]["worst"])
     ]
     return CheckResult(SECTION, summary, verdicts, rows,
-                       _comparisons(plus, model, travel_at_adams, summary["max_towing_curve_deviation_mm"]),
-                       _plots(tow, power, curves, plus, model), _notes(su, plus, minus, model, speed), worst_poses,
+                       _comparisons(paper, plus, model, travel_at_adams, summary["max_towing_curve_deviation_mm"]),
+                       _plots(paper, tow, power, curves, plus, model), _notes(paper, su, plus, minus, model, speed), worst_poses,
                        timings={k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")})
 
 
