@@ -161,7 +161,7 @@ def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -
     stats = {"tried": 0, "accepted": 0, "rejected": 0, "calc_ok": 0, "cad_built": 0, "cad_ok": 0,
              "swept": 0, "rejected_after_meshing": 0}
     fields, reasons, nan_figures = collections.Counter(), collections.Counter(), collections.Counter()
-    failures, swept = [], []
+    failures, swept_sets = [], []
     timing = {"validate_s": 0.0, "calc_s": 0.0, "cad_s": 0.0}
     parts_module = None
 
@@ -237,7 +237,7 @@ def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -
             continue
         stats["swept"] += 1
         if result is not None:
-            swept.append({"seed": set_seed, "build": built, "sweep": result})
+            swept_sets.append({"seed": set_seed, "build": built, "sweep": result})
         log(f"  {mech} CAD {stats['cad_built']}/{cad} seed {set_seed}: {built['parts']} parts, "
             f"{built['triangles']} triangles ({time.perf_counter() - t0:.1f} s)")
 
@@ -246,7 +246,7 @@ def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -
         "rejections_by_field": dict(fields.most_common()),
         "rejection_reasons": dict(reasons.most_common()),
         "documented_nan_figures": dict(nan_figures.most_common()),
-        "swept": swept,
+        "swept_sets": swept_sets,
         "timing_s": {k: round(v, 2) for k, v in timing.items()},
         "failures": failures,
     }

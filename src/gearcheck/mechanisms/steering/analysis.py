@@ -345,21 +345,24 @@ def tooth_pairs(g: RackPinionGeometry) -> list[tuple[int, int]]:
     return [(j, k) for j, ks in _tooth_pairs_by_pinion(g).items() for k in ks]
 
 
-def _offsets(px, py, flat, inv_dy, slope_x, chain) -> tuple[np.ndarray, np.ndarray]:
+def _offsets(px, py, flat, inv_dy, slope_x, chain, want_lo: bool = True, want_hi: bool = True):
     """min and max over the chain's heights of [pinion boundary x(y) − chain x(y)], per angle
     (rows of the pinion polygon's vertices px, py): over the pinion vertices within the chain's
-    heights and the pinion edges crossing the chain's vertex heights (±inf where none)."""
+    heights and the pinion edges crossing the chain's vertex heights (±inf where none; None for
+    an end not wanted)."""
     ys, xs = chain
     inside = (py >= ys[0]) & (py <= ys[-1])
     d = px - np.interp(py, ys, xs)
-    hi = np.where(inside, d, -np.inf).max(axis=1)
-    lo = np.where(inside, d, np.inf).min(axis=1)
+    hi = np.where(inside, d, -np.inf).max(axis=1) if want_hi else None
+    lo = np.where(inside, d, np.inf).min(axis=1) if want_lo else None
     for uy, ux in zip(ys, xs):
         t = (uy - py) * inv_dy
         crossing = ~flat & (t >= 0.0) & (t <= 1.0)
         x = px + (uy - py) * slope_x
-        hi = np.maximum(hi, np.where(crossing, x, -np.inf).max(axis=1) - ux)
-        lo = np.minimum(lo, np.where(crossing, x, np.inf).min(axis=1) - ux)
+        if want_hi:
+            hi = np.maximum(hi, np.where(crossing, x, -np.inf).max(axis=1) - ux)
+        if want_lo:
+            lo = np.minimum(lo, np.where(crossing, x, np.inf).min(axis=1) - ux)
     return lo, hi
 
 
@@ -405,7 +408,8 @@ def overlap_intervals(g: RackPinionGeometry, phis, flanks: bool = False):
             if flanks:
                 found = [_offsets(px, py, flat, inv_dy, slope_x, c) for c in (left_flank, right_flank)]
             else:
-                found = [(_offsets(px, py, flat, inv_dy, slope_x, right)[0], _offsets(px, py, flat, inv_dy, slope_x, left)[1])]
+                found = [(_offsets(px, py, flat, inv_dy, slope_x, right, want_hi=False)[0],
+                          _offsets(px, py, flat, inv_dy, slope_x, left, want_lo=False)[1])]
             for n, (lo_m, hi_m) in enumerate(found):
                 ok = overlap & np.isfinite(hi_m) & np.isfinite(lo_m)
                 out[2 * n][idx[ok]] = lo_m[ok]
@@ -480,14 +484,18 @@ def _overlap_depth(lo: np.ndarray, hi: np.ndarray, travel: float) -> float:
     return float(np.minimum(travel - lo[inside], hi[inside] - travel).max())
 
 
-def sweep(g: RackPinionGeometry, phis, travel_start: float, direction: int) -> Sweep:
+def sweep(g: RackPinionGeometry, phis, travel_start: float, direction: int, intervals=None) -> Sweep:
     """Swing the pinion through ``phis`` (monotone, in the sense of ``direction``) starting
     with the rack at ``travel_start``; at each angle the rack moves only as far as a pinion
     tooth pushes it through a flank, at most :func:`push_reach` per step (see
-    :data:`PUSH_NORMAL_MIN`); any overlap left (with the whole tooth) is interference."""
+    :data:`PUSH_NORMAL_MIN`); any overlap left (with the whole tooth) is interference.
+    ``intervals`` may pass (pairs, push lo, push hi, overlap lo, overlap hi) precomputed at ``phis``."""
     phis = np.asarray(phis, dtype=float)
-    pairs, lo, hi = push_intervals(g, phis, direction)
-    _, full_lo, full_hi = overlap_intervals(g, phis)
+    if intervals is None:
+        pairs, lo, hi = push_intervals(g, phis, direction)
+        _, full_lo, full_hi = overlap_intervals(g, phis)
+    else:
+        pairs, lo, hi, full_lo, full_hi = intervals
     travel = np.empty(phis.size)
     depth = np.zeros(phis.size)
     current = float(travel_start)
@@ -542,7 +550,10 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
     rack (zero-clearance grazing), and the re-engage angle (the return swing picks the rack
     up), each refined by bisection between grid angles."""
     phis = towing_grid(max_angle_deg, step_deg, extra_deg)
-    fwd = sweep(g, phis, 0.0, +1)  # angle 0: tight mesh, rack tooth 0 centred
+    # every interval once on the grid: left flanks push the forward swing, right flanks the return
+    pairs, (left_lo, left_hi), (right_lo, right_hi) = overlap_intervals(g, phis, flanks=True)
+    _, full_lo, full_hi = overlap_intervals(g, phis)
+    fwd = sweep(g, phis, 0.0, +1, (pairs, left_lo, left_hi, full_lo, full_hi))  # angle 0: tight mesh, rack tooth 0 centred
     end = float(fwd.travel_mm[-1])
     moving_late = end - np.interp(phis[-1] - math.radians(1.0), phis, fwd.travel_mm) > TRAVEL_TOL_MM
     dis = graze = math.nan
@@ -568,7 +579,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
             graze = _bisect(apart, phis[m - 1], phis[m])
 
     back_phis = phis[::-1]
-    back = sweep(g, back_phis, end, -1)
+    back = sweep(g, back_phis, end, -1, (pairs, right_lo[:, ::-1], right_hi[:, ::-1], full_lo[:, ::-1], full_hi[:, ::-1]))
     re = math.nan
     moved = back.travel_mm < end - TRAVEL_TOL_MM
     if moved.any():
