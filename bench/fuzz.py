@@ -18,7 +18,10 @@ sweep vs the independent exact model) that does not hold.
 Prints tried / accepted / rejected / swept per mechanism and the rejection reasons, writes
 out/fuzz.json (counts, histograms, timings and every failure with the set that caused it, to
 reproduce), and exits 1 if anything failed. Defaults: 1200 sets per mechanism, 35 CAD builds and
-sweeps per mechanism (105). --sets/--cad scale it; --only picks mechanisms.
+sweeps per mechanism (105). --sets/--cad scale it; --only picks mechanisms. Measured full run
+(2 cores): 3600 tried, 1100 accepted (all through calc), 105 built and swept, 10 of them rejected
+after meshing, 0 failures, 1357 s (differential 726 s: its 0.003 mm meshes; steering calc 0.7 s
+per set).
 """
 
 from __future__ import annotations

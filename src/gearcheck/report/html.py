@@ -91,7 +91,7 @@ def plot_svg(plot: Plot) -> str:
     # Horizontal reference lines go into the legend (labels at the axis edge collide).
     hlines = [(label, y) for label, y in plot.hlines if y is not None and math.isfinite(y)]
     for (label, y), colour in zip(hlines, HLINE_COLOURS * (1 + len(hlines) // len(HLINE_COLOURS))):
-        shown = label if any(c.isdigit() for c in label) else f"{label} ({y:g})"  # the value once
+        shown = label if any(c.isdigit() for c in label) else f"{label} ({y:.4g})"  # the value once
         ax.axhline(y, ls=":", lw=1.3, color=colour, label=shown)
     ax.set_title(plot.title, fontsize=11)
     ax.set_xlabel(plot.xlabel)
