@@ -107,8 +107,13 @@ def test_paper_figures_only_for_the_papers_design(templates_dir):
     from gearcheck.mechanisms.steering.check import paper_figures
 
     template = load_template(templates_dir / "nose_wheel_steering.toml").params
+    other = params_of("steering", STEERING_SEED_2000084)
     assert paper_figures(template)["disengage_deg"] == an.PAPER["disengage_deg"]
-    assert set(paper_figures(params_of("steering", STEERING_SEED_2000084)).values()) == {None}
+    assert set(paper_figures(other).values()) == {None}
+    # the calc table likewise: printed values beside the paper's design only
+    calc = mechanism_module("steering").calc
+    assert sum(f.paper is not None for f in calc(template)) >= 10
+    assert all(f.paper is None for f in calc(other))
 
 
 # --- mesh sweep against the model (CAD) ------------------------------------------------------

@@ -7,6 +7,7 @@ Reconstruction and every paper slip: docs/steering.md.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 from gearcheck.figures import Figure
@@ -71,7 +72,7 @@ def calc(params: Params) -> list[Figure]:
 
     beyond = "rack still moving at towing.max_angle_deg" if math.isnan(dis_deg) else ""
     F = Figure
-    return [
+    figures = [
         # geometry
         F("pitch_radius_mm", "pitch radius r = m·z/2", g.pitch_radius, "mm", note="paper: H − h = 107 − 23 = 84 needs m = 4 (not 5)"),
         F("tip_radius_mm", "tip radius Ra", g.tip_radius, "mm", note="line (10) gives 88.00"),
@@ -136,3 +137,6 @@ def calc(params: Params) -> list[Figure]:
         F("ddisengage_dRS1_deg_per_mm", "sensitivity dφ(disengage)/dRS1", dphi_drs1, "deg/mm", digits=2),
         F("dphiS6_dhS6_deg_per_mm", "sensitivity dφS6/dhS6", dphi_dhs6, "deg/mm", digits=2),
     ]
+    if an.is_paper_design(params):
+        return figures
+    return [dataclasses.replace(f, paper=None) for f in figures]  # another design: no printed targets

@@ -47,6 +47,16 @@ PAPER = {
     "test_travel_mm": 109.5,
 }
 
+
+
+def is_paper_design(params) -> bool:
+    """The template is the paper's mechanism (m 4, z 42, α 25°, H 107): only then do its printed
+    figures stand beside the results (beside another design they would read as targets)."""
+    p = params.pinion
+    return (math.isclose(p.module_mm, 4.0) and p.teeth == 42 and math.isclose(p.pressure_angle_deg, 25.0)
+            and math.isclose(params.layout.centre_to_datum_mm, 107.0))
+
+
 # Named tolerances.
 TRAVEL_TOL_MM = 1e-4  # rack standing still / a pair touching, within this (≫ polyline error, measured ≤ 0.04 µm)
 ANGLE_STEP_DEG = 0.05  # towing-curve grid; events are refined by bisection

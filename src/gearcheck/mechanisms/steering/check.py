@@ -780,12 +780,8 @@ def _verdicts(params, plus: dict, minus: dict, model: _Model, tol: float, poses:
 
 
 def paper_figures(params) -> dict:
-    """The paper's figures when the template is the paper's mechanism (m 4, z 42, α 25°, H 107),
-    else all None: a printed angle beside another design's result would read as a target."""
-    p = params.pinion
-    same = (math.isclose(p.module_mm, 4.0) and p.teeth == 42 and math.isclose(p.pressure_angle_deg, 25.0)
-            and math.isclose(params.layout.centre_to_datum_mm, 107.0))
-    return dict(an.PAPER) if same else dict.fromkeys(an.PAPER)
+    """The paper's figures for the paper's design, else all None (:func:`an.is_paper_design`)."""
+    return dict(an.PAPER) if an.is_paper_design(params) else dict.fromkeys(an.PAPER)
 
 
 def _comparisons(P: dict, plus: dict, model: _Model, travel_at_adams: float, max_dev: float) -> list[Comparison]:
