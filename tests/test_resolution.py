@@ -47,3 +47,19 @@ def test_no_clearance_checked_means_no_rule():
     enforce(result, {"pinion": FakeBody(0.5)}, 0.5)
     assert resolution_summary(result, {"pinion": FakeBody(0.5)}) == {"mesh_error_bound_mm": 0.5, "rule_met": 1}
     assert "no non-zero clearance" in describe(result, {"pinion": FakeBody(0.5)})
+
+
+def test_tol_help_names_each_mechanisms_default():
+    """`--help` spells the per-mechanism defaults out (the CLI does not import the mechanisms just
+    to print help): they must be the values the build uses."""
+    import re
+
+    from gearcheck.cli import build_parser
+    from gearcheck.mechanisms import MECHANISMS, mechanism_module
+
+    parser = build_parser()
+    check = next(a for a in parser._subparsers._group_actions[0].choices.values() if a.prog.endswith("check"))
+    text = " ".join(next(a.help for a in check._actions if a.dest == "tol").split())
+    for name in MECHANISMS:
+        found = re.search(rf"{name} ([0-9.]+)", text)
+        assert found and float(found.group(1)) == mechanism_module(name).MESH_TOL_MM, name
