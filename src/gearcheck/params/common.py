@@ -56,6 +56,18 @@ class ParamError(Exception):
         return ParamError(self.field, self.value, self.allowed, source)
 
 
+def bisect_boundary(ok, good: float, bad: float, steps: int) -> float | None:
+    """Where ``ok`` changes between ``good`` (ok) and ``bad`` (not ok), by ``steps`` bisections,
+    on the ok side; None if ``ok(good)`` fails (no boundary in the bracket). The models use it to
+    say how far a rejected value may go."""
+    if not ok(good):
+        return None
+    for _ in range(steps):
+        mid = 0.5 * (good + bad)
+        good, bad = (mid, bad) if ok(mid) else (good, mid)
+    return good
+
+
 def _one_line(text: str) -> str:
     """Control characters (a newline in a TOML key or file name) shown escaped: one line."""
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in str(text))

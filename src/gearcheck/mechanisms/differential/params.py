@@ -16,7 +16,7 @@ import math
 from pydantic import Field, model_validator
 
 from gearcheck.mechanisms.differential import analysis, poses  # numpy only
-from gearcheck.params.common import ParamError, Section
+from gearcheck.params.common import ParamError, Section, bisect_boundary
 
 # The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
 # d2/2, a/2 = l2 + d1/2). 0.05 mm is about 3′ of backlash per side (eq 11): within what the
@@ -256,14 +256,8 @@ def _with(params: "Params", section: str, **values) -> "Params":
     return params.model_copy(update={section: getattr(params, section).model_copy(update=values)})
 
 
-def _boundary(ok, good: float, bad: float, steps: int = 50) -> float | None:
-    """Where ``ok`` changes between ``good`` and ``bad`` (bisection); None if ``ok(good)`` fails."""
-    if not ok(good):
-        return None
-    for _ in range(steps):
-        mid = 0.5 * (good + bad)
-        good, bad = (mid, bad) if ok(mid) else (good, mid)
-    return good
+def _boundary(ok, good: float, bad: float) -> float | None:
+    return bisect_boundary(ok, good, bad, steps=50)
 
 
 def _blame(params: "Params", why: str) -> ParamError:

@@ -18,6 +18,7 @@ from pydantic import Field, model_validator
 
 from gearcheck.mechanisms.steering import analysis, layout
 from gearcheck.params import ParamError, Section
+from gearcheck.params.common import bisect_boundary
 
 MM = {"unit": "mm"}
 DEG = {"unit": "deg"}
@@ -228,15 +229,10 @@ def _check_trim_clearance(g) -> None:
                          "its tangent at S2 (hS6_max)")
 
 
-def _boundary(ok, good: float, bad: float, steps: int = 60) -> float:
-    """Where ``ok`` changes between ``good`` (ok) and ``bad`` (not ok), by bisection; ``good`` if
-    ``ok(good)`` fails too (no boundary in the bracket)."""
-    if not ok(good):
-        return good
-    for _ in range(steps):
-        mid = 0.5 * (good + bad)
-        good, bad = (mid, bad) if ok(mid) else (good, mid)
-    return good
+def _boundary(ok, good: float, bad: float) -> float:
+    """:func:`bisect_boundary`, or ``good`` when there is no boundary in the bracket."""
+    found = bisect_boundary(ok, good, bad, steps=60)
+    return good if found is None else found
 
 
 def _form_radius(r: float, rb: float, a: float, depth: float) -> float:
