@@ -142,9 +142,11 @@ def rack_flank_faces(g, rack: MeshData) -> tuple[np.ndarray, np.ndarray]:
     return left, right
 
 
-def sweep_meshes(g, pinion: Body, rack: Body, centre_height_mm: float) -> tuple[list[MeshData], dict]:
+def sweep_meshes(pinion: Body, rack: Body, centre_height_mm: float, flanks: tuple[np.ndarray, np.ndarray]
+                 ) -> tuple[list[MeshData], dict]:
     """The meshes the sweep uses (own frames): pinion and rack side walls that can meet, and the
-    rack's left and right flanks apart (the faces that push). Also returns counts for the report."""
+    rack's left and right flanks apart (``flanks``: :func:`rack_flank_faces`, the faces that push).
+    Also returns counts for the report."""
     zp, zr = pinion.mesh.vertices[:, 2], rack.mesh.vertices[:, 2]
     same_z = abs(zp.min() - zr.min()) < 1e-6 and abs(zp.max() - zr.max()) < 1e-6
     np_, nr = _normals(pinion.mesh), _normals(rack.mesh)
@@ -156,7 +158,7 @@ def sweep_meshes(g, pinion: Body, rack: Body, centre_height_mm: float) -> tuple[
     keep_p = walls_p & (radius >= reach)
     tip = float(radius.max())
     keep_r = walls_r & (rack.mesh.vertices[:, 1][rack.mesh.faces].max(axis=1) >= centre_height_mm - tip - WALL_REACH_MARGIN_MM)
-    left, right = rack_flank_faces(g, rack.mesh)
+    left, right = flanks
     meshes = [
         submesh(pinion.mesh, PINION, keep_p),
         submesh(rack.mesh, RACK, keep_r),
@@ -625,7 +627,8 @@ def _prepare(params, bodies: dict[str, Body], towing_step_deg: float, power_step
     bound = pinion.error_bound_mm + rack.error_bound_mm
     kin = Kinematics.from_bodies(pinion, rack)
     centre_height = float(kin.pinion_origin[1])
-    meshes, mesh_info = sweep_meshes(g, pinion, rack, centre_height)
+    flanks = rack_flank_faces(g, rack.mesh)
+    meshes, mesh_info = sweep_meshes(pinion, rack, centre_height, flanks)
     tip = float(np.hypot(pinion.mesh.vertices[:, 0], pinion.mesh.vertices[:, 1]).max())
     rack_top = float(rack.mesh.vertices[:, 1].max())
 
@@ -637,7 +640,7 @@ def _prepare(params, bodies: dict[str, Body], towing_step_deg: float, power_step
         raise ValueError("the rack mesh has no vertex at the S6 corner of the drawing")
     nr = _normals(rack.mesh)
     touches = np.any(np.hypot(rv[rf][..., 0] - corner[0], rv[rf][..., 1] - corner[1]) < 1e-6, axis=1)
-    facing = np.flatnonzero(touches & rack_flank_faces(g, rack.mesh)[1])
+    facing = np.flatnonzero(touches & flanks[1])
     a = g.pressure_angle_rad
     normal = nr[facing[0], :2] / np.linalg.norm(nr[facing[0], :2]) if facing.size else np.array([math.cos(a), math.sin(a)])
     up = np.array([-normal[1], normal[0]])
