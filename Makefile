@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.gearcheck-installed
 
-.PHONY: install demo test bench fuzz clean
+.PHONY: install demo test lint bench fuzz clean
 
 install: $(STAMP)
 
@@ -18,8 +18,15 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(PY) -m gearcheck demo --out out
 
+# Lint and type-check first (seconds), then the suite.
 test: $(STAMP)
+	$(VENV)/bin/ruff check src bench
+	$(VENV)/bin/mypy
 	$(PY) -m pytest -q
+
+lint: $(STAMP)
+	$(VENV)/bin/ruff check src bench
+	$(VENV)/bin/mypy
 
 bench: $(STAMP)
 	$(PY) bench/run.py --out out/bench.json

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import collections
+import copy
 import json
 import math
 import platform
@@ -40,58 +41,41 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from gearcheck import __version__  # noqa: E402
-from gearcheck.mechanisms import MECHANISMS, Loaded, load_template, mechanism_module  # noqa: E402
-from gearcheck.mechanisms.sampling import NAN_FIGURES, RandomDraw, sample  # noqa: E402
+from gearcheck import __version__, pipeline  # noqa: E402
+from gearcheck.design import Design, load_template  # noqa: E402
+from gearcheck.mechanism import Mechanism, get, names  # noqa: E402
+from gearcheck.mechanisms.sampling import RandomDraw  # noqa: E402
 from gearcheck.output import atomic_write_text, ensure_out_dir  # noqa: E402
 from gearcheck.params import ParamError, validate  # noqa: E402
 
-TEMPLATES = {
-    "differential": ROOT / "templates" / "zhurong_differential.toml",
-    "track": ROOT / "templates" / "eod_track_drive.toml",
-    "steering": ROOT / "templates" / "nose_wheel_steering.toml",
-}
+TEMPLATE_DIR = ROOT / "templates"
 MESH_TOL_MM = 0.02
-# Seeds of mechanism k start at k·SEED_STRIDE (disjoint streams, reproducible one by one).
-SEED_STRIDE = 1_000_000
 
 
-# Verdicts that test the tool itself (mesh sweep vs an independent exact model), not the design:
-# an accepted set may fail a design verdict (a mesh that binds cold), never one of these.
-CONSISTENCY_VERDICTS = ("mesh_agrees_with_exact", "mesh_matches_exact", "towing_curve")
-# The differential sweep at fuzz scale: 4 drive angles over the play period, the set's own shim.
-FUZZ_DIFFERENTIAL_ANGLES = 4
-
-
-def sweep_sample(loaded: Loaded, parts: list) -> dict | None:
-    """The FCL sweep of one fuzzed, built set: mesh at the check's default tolerance, run the
-    mechanism's check (the differential at reduced sampling), return its verdicts as numbers.
+def sweep_sample(design: Design) -> dict:
+    """The FCL sweep of one fuzzed, built set through the pipeline: mesh at the check's default
+    tolerance (as `gearcheck check` meshes), sweep with the mechanism's fuzz options (cheaper
+    sampling where it has them), apply the mesh-resolution rule; return the verdicts as numbers.
 
     Raises when a consistency verdict fails (mesh sweep disagrees with the exact model): that is
-    a defect of gearcheck, whatever the design. Design verdicts are recorded, not failures."""
+    a defect of gearcheck, whatever the design. Design verdicts are recorded, not failures.
+    ParamError: rejected after meshing."""
     import tempfile
 
-    from gearcheck.cad.export import export_parts, sweep_bodies
+    from gearcheck import resolution
 
-    from gearcheck.sweep import resolution
-
-    tol = loaded.module.MESH_TOL_MM  # the check's default, as `gearcheck check` meshes
+    impl = design.impl
     with tempfile.TemporaryDirectory() as tmp:
-        _, exported = export_parts(parts, Path(tmp), name="fuzz", mechanism=loaded.mechanism,
-                                   params_data=loaded.resolved_data, tol_mm=tol)
-    bodies = sweep_bodies(exported)
-    kwargs = {}
-    if loaded.mechanism == "differential":
-        kwargs = {"angles_per_cycle": FUZZ_DIFFERENTIAL_ANGLES, "shims_mm": [loaded.params.shim.thickness_mm]}
-    result = loaded.check_module.run_check(loaded.params, bodies, **kwargs)
-    resolution.enforce(result, bodies, tol, "fuzz")  # ParamError: rejected after meshing
-    verdicts = {v.key: int(v.passed) for v in result.verdicts}
-    broken = [k for k in CONSISTENCY_VERDICTS if verdicts.get(k) == 0]
+        run = pipeline.build(design, Path(tmp))
+    result = pipeline.sweep(design, run.assembly, run.bodies, options=impl.fuzz_options(design.params))
+    pipeline.apply_resolution_rule(design, result, run.bodies, run.tol_mm)
+    verdicts = {v.name: int(v.passed) for v in result.verdicts}
+    broken = [k for k in impl.consistency_verdicts if verdicts.get(k) == 0]
     if broken:
-        details = "; ".join(v.detail for v in result.verdicts if v.key in broken)
+        details = "; ".join(v.measured for v in result.verdicts if v.name in broken)
         raise AssertionError(f"mesh sweep disagrees with the exact model: {details}")
     return {"verdicts": verdicts, "verdict_pass": int(result.passed),
-            "mesh_resolution": resolution.resolution_summary(result, bodies)}
+            "mesh_resolution": resolution.resolution_summary(result, run.bodies)}
 
 
 def _reason(exc: ParamError) -> str:
@@ -123,13 +107,13 @@ def check_rejection(body: dict, exc: ParamError, source: str = "fuzz") -> str | 
     return None
 
 
-def check_figures(mech: str, figures) -> tuple[str | None, list[str]]:
-    nan = []
+def check_figures(impl: Mechanism, figures) -> tuple[str | None, list[str]]:
+    nan: list[str] = []
     for f in figures:
         if math.isinf(f.value):
             return f"figure {f.key} is infinite", nan
         if math.isnan(f.value):
-            if f.key not in NAN_FIGURES[mech]:
+            if f.key not in impl.nan_figures:
                 return f"figure {f.key} is NaN (not documented as possible)", nan
             nan.append(f.key)
     return None, nan
@@ -158,101 +142,120 @@ def check_parts(parts) -> tuple[str | None, dict]:
                   "mesh_error_bound_mm": worst_error}
 
 
-def fuzz_mechanism(mech: str, index: int, sets: int, cad: int, seed: int, log) -> dict:
-    module = mechanism_module(mech)
-    base = load_template(TEMPLATES[mech]).data
-    stats = {"tried": 0, "accepted": 0, "rejected": 0, "calc_ok": 0, "cad_built": 0, "cad_ok": 0,
-             "swept": 0, "rejected_after_meshing": 0}
-    fields, reasons, nan_figures = collections.Counter(), collections.Counter(), collections.Counter()
-    failures, swept_sets = [], []
-    timing = {"validate_s": 0.0, "calc_s": 0.0, "cad_s": 0.0}
-    parts_module = None
+class _Run:
+    """One mechanism's fuzz: counts, histograms, timings and failures, stage by stage."""
 
-    def fail(stage: str, set_seed: int, data: dict, error: str) -> None:
-        failures.append({"mechanism": mech, "seed": set_seed, "stage": stage, "error": error, "set": data})
-        log(f"  FAIL {mech} seed {set_seed} [{stage}]: {error.splitlines()[-1] if error else ''}")
+    def __init__(self, impl: Mechanism, log):
+        self.impl, self.log = impl, log
+        self.stats = {"tried": 0, "accepted": 0, "rejected": 0, "calc_ok": 0, "cad_built": 0, "cad_ok": 0,
+                      "swept": 0, "rejected_after_meshing": 0}
+        self.fields: collections.Counter = collections.Counter()
+        self.reasons: collections.Counter = collections.Counter()
+        self.nan_figures: collections.Counter = collections.Counter()
+        self.failures: list[dict] = []
+        self.swept_sets: list[dict] = []
+        self.timing = {"validate_s": 0.0, "calc_s": 0.0, "cad_s": 0.0}
 
-    for i in range(sets):
-        set_seed = seed + index * SEED_STRIDE + i
-        data = sample(base, RandomDraw(set_seed))
+    def fail(self, stage: str, set_seed: int, data: dict, error: str) -> None:
+        self.failures.append({"mechanism": self.impl.name, "seed": set_seed, "stage": stage, "error": error,
+                              "set": data})
+        self.log(f"  FAIL {self.impl.name} seed {set_seed} [{stage}]: {error.splitlines()[-1] if error else ''}")
+
+    def validated(self, set_seed: int, data: dict):
+        """The set's Params, or None (rejected: counted, its message checked)."""
         body = {k: v for k, v in data.items() if k != "mechanism"}
-        stats["tried"] += 1
+        self.stats["tried"] += 1
         t0 = time.perf_counter()
         try:
-            params = validate(module.Params, body, "fuzz")
+            return validate(self.impl.Params, body, "fuzz")
         except ParamError as exc:
-            timing["validate_s"] += time.perf_counter() - t0
-            stats["rejected"] += 1
-            fields[exc.field] += 1
-            reasons[_reason(exc)] += 1
+            self.stats["rejected"] += 1
+            self.fields[exc.field] += 1
+            self.reasons[_reason(exc)] += 1
             problem = check_rejection(body, exc)
             if problem:
-                fail("reject", set_seed, data, f"{problem}: {exc}")
-            continue
+                self.fail("reject", set_seed, data, f"{problem}: {exc}")
         except Exception:
-            timing["validate_s"] += time.perf_counter() - t0
-            fail("validate", set_seed, data, traceback.format_exc())
-            continue
-        timing["validate_s"] += time.perf_counter() - t0
-        stats["accepted"] += 1
+            self.fail("validate", set_seed, data, traceback.format_exc())
+        finally:
+            self.timing["validate_s"] += time.perf_counter() - t0
+        return None
 
+    def calc_ok(self, set_seed: int, data: dict, params) -> bool:
         t0 = time.perf_counter()
         try:
-            problem, nan = check_figures(mech, module.calc(params))
+            problem, nan = check_figures(self.impl, self.impl.analyse(params))
         except Exception:
             problem, nan = traceback.format_exc(), []
-        timing["calc_s"] += time.perf_counter() - t0
-        nan_figures.update(nan)
+        self.timing["calc_s"] += time.perf_counter() - t0
+        self.nan_figures.update(nan)
         if problem:
-            fail("calc", set_seed, data, problem)
-            continue
-        stats["calc_ok"] += 1
+            self.fail("calc", set_seed, data, problem)
+            return False
+        self.stats["calc_ok"] += 1
+        return True
 
-        if stats["cad_built"] >= cad:
-            continue
-        if parts_module is None:
-            parts_module = load_template(TEMPLATES[mech]).parts_module  # imports CadQuery once
-        stats["cad_built"] += 1
+    def cad_and_sweep(self, set_seed: int, data: dict, params, cad: int) -> None:
+        mech = self.impl.name
+        self.stats["cad_built"] += 1
         t0 = time.perf_counter()
+        design = Design(Path(f"fuzz/{mech}-{set_seed}.toml"), mech, params, data)
         try:
-            parts = parts_module.build_parts(params)
+            _, parts = pipeline.build_parts(design)
             problem, built = check_parts(parts)
         except Exception:
             problem, built = traceback.format_exc(), {}
-        timing["cad_s"] += time.perf_counter() - t0
+        self.timing["cad_s"] += time.perf_counter() - t0
         if problem:
-            fail("cad", set_seed, data, problem)
-            continue
-        stats["cad_ok"] += 1
-        loaded = Loaded(path=Path(f"fuzz/{mech}-{set_seed}.toml"), mechanism=mech, params=params, data=data)
+            self.fail("cad", set_seed, data, problem)
+            return
+        self.stats["cad_ok"] += 1
         try:
-            result = sweep_sample(loaded, parts)
+            result = sweep_sample(design)
         except ParamError as exc:  # the mesh-resolution rule: a clear rejection, not a failure
-            stats["rejected_after_meshing"] += 1
+            self.stats["rejected_after_meshing"] += 1
             problem = check_rejection({"--tol": 0}, exc, source="fuzz")
             if problem:
-                fail("mesh-rule", set_seed, data, f"{problem}: {exc}")
+                self.fail("mesh-rule", set_seed, data, f"{problem}: {exc}")
             else:
-                reasons[_reason(exc)] += 1
-            continue
+                self.reasons[_reason(exc)] += 1
+            return
         except Exception:
-            fail("sweep", set_seed, data, traceback.format_exc())
-            continue
-        stats["swept"] += 1
-        if result is not None:
-            swept_sets.append({"seed": set_seed, "build": built, "sweep": result})
-        log(f"  {mech} CAD {stats['cad_built']}/{cad} seed {set_seed}: {built['parts']} parts, "
-            f"{built['triangles']} triangles ({time.perf_counter() - t0:.1f} s)")
+            self.fail("sweep", set_seed, data, traceback.format_exc())
+            return
+        self.stats["swept"] += 1
+        self.swept_sets.append({"seed": set_seed, "build": built, "sweep": result})
+        self.log(f"  {mech} CAD {self.stats['cad_built']}/{cad} seed {set_seed}: {built['parts']} parts, "
+                 f"{built['triangles']} triangles ({time.perf_counter() - t0:.1f} s)")
 
-    return {
-        **stats,
-        "rejections_by_field": dict(fields.most_common()),
-        "rejection_reasons": dict(reasons.most_common()),
-        "documented_nan_figures": dict(nan_figures.most_common()),
-        "swept_sets": swept_sets,
-        "timing_s": {k: round(v, 2) for k, v in timing.items()},
-        "failures": failures,
-    }
+    def summary(self) -> dict:
+        return {
+            **self.stats,
+            "rejections_by_field": dict(self.fields.most_common()),
+            "rejection_reasons": dict(self.reasons.most_common()),
+            "documented_nan_figures": dict(self.nan_figures.most_common()),
+            "swept_sets": self.swept_sets,
+            "timing_s": {k: round(v, 2) for k, v in self.timing.items()},
+            "failures": self.failures,
+        }
+
+
+def fuzz_mechanism(impl: Mechanism, sets: int, cad: int, seed: int, log) -> dict:
+    """``sets`` random sets of one mechanism through validation and calc; the first ``cad``
+    accepted ones through the CAD build, meshing and the sweep."""
+    base = load_template(TEMPLATE_DIR / str(impl.template)).data
+    run = _Run(impl, log)
+    for i in range(sets):
+        set_seed = seed + impl.fuzz_seed_base + i
+        data = copy.deepcopy(base)
+        impl.sample(data, RandomDraw(set_seed))
+        params = run.validated(set_seed, data)
+        if params is None:
+            continue
+        run.stats["accepted"] += 1
+        if run.calc_ok(set_seed, data, params) and run.stats["cad_built"] < cad:
+            run.cad_and_sweep(set_seed, data, params, cad)
+    return run.summary()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -261,7 +264,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cad", type=int, default=35, help="accepted sets built per mechanism (default 35)")
     parser.add_argument("--seed", type=int, default=0, help="first seed (default 0)")
     parser.add_argument("--out", type=Path, default=ROOT / "out" / "fuzz.json")
-    parser.add_argument("--only", choices=sorted(MECHANISMS), action="append", help="fuzz only these mechanisms")
+    parser.add_argument("--only", choices=names(), action="append", help="fuzz only these mechanisms")
     args = parser.parse_args(argv)
 
     def log(text: str) -> None:
@@ -269,12 +272,13 @@ def main(argv: list[str] | None = None) -> int:
 
     t_start = time.perf_counter()
     results = {}
-    for index, mech in enumerate(TEMPLATES):
-        if args.only and mech not in args.only:
+    for mech in names():
+        impl = get(mech)
+        if (args.only and mech not in args.only) or impl.template is None:
             continue
         log(f"{mech}: {args.sets} sets, CAD for the first {args.cad} accepted ...")
         t0 = time.perf_counter()
-        results[mech] = fuzz_mechanism(mech, index, args.sets, args.cad, args.seed, log)
+        results[mech] = fuzz_mechanism(impl, args.sets, args.cad, args.seed, log)
         results[mech]["elapsed_s"] = round(time.perf_counter() - t0, 1)
     elapsed = time.perf_counter() - t_start
 
@@ -298,7 +302,7 @@ def main(argv: list[str] | None = None) -> int:
         "gearcheck_version": __version__,
         "python": platform.python_version(),
         "settings": {"sets_per_mechanism": args.sets, "cad_per_mechanism": args.cad, "first_seed": args.seed,
-                     "seed_stride": SEED_STRIDE, "mesh_tol_mm": MESH_TOL_MM},
+                     "seed_bases": {m: get(m).fuzz_seed_base for m in results}, "mesh_tol_mm": MESH_TOL_MM},
         "elapsed_s": round(elapsed, 1),
         "totals": {**totals, "failures": len(failures)},
         "mechanisms": results,

@@ -12,13 +12,15 @@ import platform
 import statistics
 import sys
 import time
+from typing import Any
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from gearcheck import __version__  # noqa: E402
-from gearcheck.mechanisms import load_template  # noqa: E402
+from gearcheck import __version__, pipeline  # noqa: E402
+from gearcheck.design import load_template  # noqa: E402
+from gearcheck.executor import available_cores  # noqa: E402
 from gearcheck.output import atomic_write_text, ensure_out_dir  # noqa: E402
 
 TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
@@ -36,61 +38,49 @@ def median_time(fn, repeat: int) -> dict:
 def bench_calc(repeat: int) -> dict:
     out = {}
     for path in TEMPLATES:
-        loaded = load_template(path)
-        out[path.stem] = median_time(lambda: loaded.module.calc(loaded.params), repeat)
+        design = load_template(path)
+        out[path.stem] = median_time(design.calc, repeat)
     return out
 
 
 def bench_build(repeat: int) -> dict:
-    """CAD build time per part kind (median of ``repeat``), cadquery imported once beforehand."""
-    import cadquery  # noqa: F401  (import cost kept out of the figures)
-
-    from gearcheck.cad.bevel import build_bevel_gear
-    from gearcheck.cad.rack_pinion import build_pinion, build_rack
-    from gearcheck.cad.sprocket import build_sprocket, sprocket_spec
-    from gearcheck.mechanisms.differential.poses import gear_specs
-    from gearcheck.mechanisms.steering.analysis import geometry_from_params
-
-    diff = load_template(ROOT / "templates" / "zhurong_differential.toml").params
-    track = load_template(ROOT / "templates" / "eod_track_drive.toml").params
-    steer = load_template(ROOT / "templates" / "nose_wheel_steering.toml").params
-    specs = gear_specs(diff)
-    g = geometry_from_params(steer)
-    spec = sprocket_spec(track)
-    return {
-        "bevel_gear_z33": median_time(lambda: build_bevel_gear(specs.big), repeat),
-        "bevel_gear_z13": median_time(lambda: build_bevel_gear(specs.small), repeat),
-        "sprocket_z49": median_time(lambda: build_sprocket(spec), repeat),
-        "pinion_z42": median_time(lambda: build_pinion(g), repeat),
-        "rack": median_time(lambda: build_rack(g), repeat),
-    }
-
-
-def bench_sweeps(repeat: int) -> dict:
-    """Each mechanism's sweep on its default meshes (the tolerance `check` uses: differential
-    0.003 mm, track 0.008, steering 0.01): wall time (median) and the speed figures the check
-    reports (poses/s, ms per play measurement...) from the median run."""
-    import tempfile
-
-    from gearcheck.cad.export import export_parts, sweep_bodies
+    """CAD build time per template (assembly as data → solids, no meshing, no files; median of
+    ``repeat``), cadquery imported once beforehand."""
+    import gearcheck.cad.export  # noqa: F401  (the CAD kernel's import cost kept out of the figures)
 
     out = {}
     for path in TEMPLATES:
-        loaded = load_template(path)
-        parts = loaded.parts_module.build_parts(loaded.params)
+        design = load_template(path)
+        out[path.stem] = median_time(lambda d=design: pipeline.build_parts(d), repeat)
+    return out
+
+
+def bench_sweeps(repeat: int) -> dict:
+    """Each mechanism's sweep on its default meshes (the tolerance `check` uses), through the
+    pipeline on 1 worker and on every core, side by side: wall time (median), the speed-up, and
+    the speed figures the check reports (poses/s, ms per play measurement...) from the median
+    run on every core."""
+    import tempfile
+
+    out = {}
+    cores = available_cores()
+    for path in TEMPLATES:
+        design = load_template(path)
         with tempfile.TemporaryDirectory() as tmp:
-            _, exported = export_parts(parts, Path(tmp), name=loaded.name, mechanism=loaded.mechanism,
-                                       params_data=loaded.resolved_data, tol_mm=loaded.module.MESH_TOL_MM)
-        bodies = sweep_bodies(exported)
-        runs = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            result = loaded.check_module.run_check(loaded.params, bodies)
-            runs.append((time.perf_counter() - t0, result.timings))
-        runs.sort(key=lambda r: r[0])
-        wall, timings = runs[len(runs) // 2]
-        out[path.stem] = {"median_s": wall, "runs_s": [r[0] for r in runs], "mesh_tol_mm": loaded.module.MESH_TOL_MM,
-                          "figures_of_median_run": timings}
+            run = pipeline.build(design, Path(tmp))
+        entry: dict = {"mesh_tol_mm": run.tol_mm}
+        for label, jobs in (("jobs_1", 1), (f"jobs_{cores}", cores)):
+            runs = []
+            for _ in range(repeat):
+                t0 = time.perf_counter()
+                result = pipeline.sweep(design, run.assembly, run.bodies, jobs=jobs)
+                runs.append((time.perf_counter() - t0, result.timings))
+            runs.sort(key=lambda r: r[0])
+            wall, timings = runs[len(runs) // 2]
+            entry[label] = {"median_s": wall, "runs_s": [r[0] for r in runs], "figures_of_median_run": timings}
+        entry["median_s"] = entry[f"jobs_{cores}"]["median_s"]
+        entry["speedup_all_cores_over_1"] = entry["jobs_1"]["median_s"] / entry["median_s"]
+        out[path.stem] = entry
     return out
 
 
@@ -114,11 +104,11 @@ def main() -> int:
     ap.add_argument("--repeat-sweep", type=int, default=3, help="runs of each sweep and of check --all")
     args = ap.parse_args()
     ensure_out_dir(args.out.parent)
-    result = {
+    result: dict[str, Any] = {
         "gearcheck_version": __version__,
         "python": platform.python_version(),
         "machine": platform.machine(),
-        "cpus": __import__("os").cpu_count(),
+        "cpus": available_cores(),
         "calc": bench_calc(args.repeat),
         "build": bench_build(3),
         "build_all_wall": bench_command_all("build", 3),
@@ -131,7 +121,8 @@ def main() -> int:
             print(f"{group:5s} {name:28s} median {fig['median_s'] * 1e3:8.1f} ms")
     print(f"build --all (fresh process)         median {result['build_all_wall']['median_s']:8.2f} s")
     for name, fig in result["sweep"].items():
-        print(f"sweep {name:28s} median {fig['median_s']:8.2f} s  {fig['figures_of_median_run']}")
+        speedup = fig["speedup_all_cores_over_1"]
+        print(f"sweep {name:28s} median {fig['median_s']:8.2f} s  ({speedup:.2f}x over 1 worker)")
     print(f"check --all (fresh process)         median {result['check_all_wall']['median_s']:8.2f} s")
     print(f"wrote {args.out}")
     return 0

@@ -13,22 +13,19 @@ def templates_dir() -> Path:
 
 @pytest.fixture(scope="session")
 def build_bodies(tmp_path_factory):
-    """Factory: build a template (with --set overrides), export it to a temp folder and return
-    (loaded template, parts, sweep bodies); each distinct request is built once per session."""
+    """Factory: build a template (with --set overrides) through the pipeline into a temp folder
+    and return its :class:`gearcheck.pipeline.BuildRun` (design, assembly, parts, bodies,
+    manifest); each distinct request is built once per session."""
     cache = {}
 
     def build(name: str, overrides: tuple[str, ...] = (), tol_mm: float = 0.01):
         key = (name, tuple(overrides), tol_mm)
         if key not in cache:
-            from gearcheck.cad.export import export_parts, sweep_bodies
-            from gearcheck.mechanisms import load_template
+            from gearcheck import pipeline
+            from gearcheck.design import load_template
 
-            loaded = load_template(TEMPLATES / f"{name}.toml", list(overrides))
-            parts = loaded.parts_module.build_parts(loaded.params)
-            out = tmp_path_factory.mktemp(name)
-            _, exported = export_parts(parts, out, name=name, mechanism=loaded.mechanism,
-                                       params_data=loaded.resolved_data, tol_mm=tol_mm)
-            cache[key] = (loaded, parts, sweep_bodies(exported))
+            design = load_template(TEMPLATES / f"{name}.toml", list(overrides))
+            cache[key] = pipeline.build(design, tmp_path_factory.mktemp(name), tol_mm=tol_mm)
         return cache[key]
 
     return build

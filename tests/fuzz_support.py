@@ -8,8 +8,9 @@ from pathlib import Path
 
 from hypothesis import strategies as st
 
-from gearcheck.mechanisms import load_template, mechanism_module
-from gearcheck.mechanisms.sampling import NAN_FIGURES, sample
+from gearcheck.design import Design, load_template
+from gearcheck.mechanism import get as mechanism
+from gearcheck.mechanisms.sampling import sample
 from gearcheck.params import ParamError, validate
 
 TEMPLATE_DIR = Path(__file__).resolve().parents[1] / "templates"
@@ -20,7 +21,12 @@ TEMPLATES = {
 }
 BASE = {mech: load_template(TEMPLATE_DIR / name).data for mech, name in TEMPLATES.items()}
 
-NAN_ALLOWED = NAN_FIGURES
+NAN_ALLOWED = {mech: mechanism(mech).nan_figures for mech in TEMPLATES}
+
+
+def design_of(mech: str, params) -> Design:
+    """A design from validated parameters (no template file), named "fuzz"."""
+    return Design(None, mech, params, {"mechanism": mech, "name": "fuzz"})
 
 
 class HypothesisDraw:
@@ -51,7 +57,7 @@ def draw_set(mech: str, data) -> dict:
 def validate_set(mech: str, body: dict):
     """The validated Params, or the ParamError (after checking its one-line form)."""
     try:
-        return validate(mechanism_module(mech).Params, body, "fuzz.toml")
+        return validate(mechanism(mech).Params, body, "fuzz.toml")
     except ParamError as exc:
         check_rejection(mech, body, exc)
         return exc

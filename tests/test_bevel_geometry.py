@@ -40,7 +40,7 @@ def test_pitch_cones_roll_on_each_other(z1, z2, sigma):
 
 
 def test_differential_pair_cones():
-    # reference.md §1: δ = atan(33/13) ≈ 68.5°, Re = 44.34 mm, d = 32.5 / 82.5 mm
+    # docs/differential.md: δ = atan(33/13) ≈ 68.5°, Re = 44.34 mm, d = 32.5 / 82.5 mm
     assert math.degrees(PINION.pitch_angle_rad) == pytest.approx(21.50, abs=0.01)
     assert math.degrees(GEAR.pitch_angle_rad) == pytest.approx(68.50, abs=0.01)
     assert PINION.outer_cone_distance_mm == pytest.approx(44.34, abs=0.005)
@@ -228,7 +228,7 @@ def test_section_points_lie_on_the_flank_cones(spec):
 def test_section_outline_is_closed_and_counter_clockwise(spec):
     prof = section_profile(spec, 25.0, flank_points=400)
     segs = prof.segments
-    for a, b in zip(segs, segs[1:] + segs[:1]):
+    for a, b in zip(segs, segs[1:] + segs[:1], strict=True):
         assert np.array_equal(a.points[-1], b.points[0])
     poly = prof.polyline(arc_points=2001)
     x, y = poly.T
@@ -245,7 +245,7 @@ def test_section_outline_is_closed_and_counter_clockwise(spec):
 
 def test_sections_are_homothetic_about_the_apex():
     a, b = section_profile(GEAR, 12.0), section_profile(GEAR, 30.0)
-    for sa, sb in zip(a.segments, b.segments):
+    for sa, sb in zip(a.segments, b.segments, strict=True):
         assert np.allclose(sb.points, sa.points * 2.5, rtol=0, atol=1e-12)
 
 
@@ -254,7 +254,7 @@ def test_sector_profile_is_tooth_zero():
     sector = section_profile(PINION, 30.0, sector=True)
     assert [s.kind for s in sector.segments] == ["side", "root"] + \
         [s.kind for s in full.segments[:5]] + ["root", "side"]
-    for s, f in zip(sector.segments[2:7], full.segments[:5]):
+    for s, f in zip(sector.segments[2:7], full.segments[:5], strict=True):
         assert np.allclose(s.points, f.points, atol=1e-13)
     half = math.pi / PINION.teeth
     assert math.atan2(*sector.segments[0].points[1][::-1]) == pytest.approx(-half)
@@ -334,7 +334,7 @@ def test_analytic_volume_matches_a_grid_integration(spec):
     rho, z = 0.5 * (rho[1:] + rho[:-1]), 0.5 * (z[1:] + z[:-1])
     R, Z = np.meshgrid(rho, z)
     inside = np.zeros(R.shape, bool)
-    for (x1, y1), (x2, y2) in zip(poly, np.roll(poly, -1, axis=0)):  # even-odd rule
+    for (x1, y1), (x2, y2) in zip(poly, np.roll(poly, -1, axis=0), strict=True):  # even-odd rule
         crosses = (y1 > Z) != (y2 > Z)
         with np.errstate(divide="ignore", invalid="ignore"):
             inside ^= crosses & (R < x1 + (x2 - x1) * (Z - y1) / (y2 - y1))
@@ -347,3 +347,58 @@ def test_analytic_volume_matches_a_grid_integration(spec):
     v = analytic_volume_mm3(spec)
     assert v == pytest.approx(analytic_volume_mm3(spec, nodes=100), abs=1e-6)  # converged
     assert grid == pytest.approx(v, rel=2e-4)  # grid cells straddling the boundary
+
+
+# -- gears in mesh as rigid bodies (geometry.bevel_mesh) ------------------------------------
+def _pair(big_turn: float = 0.0, small_turn: float = 0.0) -> np.ndarray:
+    """Small frame → big frame of the nominal pair, each gear turned about its own axis."""
+    from gearcheck.geometry.bevel_play import nominal_small_pose, rot_z4
+
+    return rot_z4(-big_turn) @ nominal_small_pose(GEAR, PINION) @ rot_z4(small_turn)
+
+
+def test_congruent_pairs_are_whole_pitches_apart():
+    # identical teeth relabelled: whole pitches of either gear give the same mesh; half a pitch
+    # of either, or a rolled pose of both, does not (the rolled pose is congruent only at whole
+    # pitches of the drive)
+    from gearcheck.geometry.bevel_mesh import congruent
+
+    q = _pair()
+    for k, j in ((1, 0), (0, 1), (3, -2)):
+        assert congruent(q, _pair(k * GEAR.angular_pitch_rad, j * PINION.angular_pitch_rad), GEAR, PINION)
+    assert not congruent(q, _pair(0.5 * GEAR.angular_pitch_rad), GEAR, PINION)
+    assert not congruent(q, _pair(0.0, 0.5 * PINION.angular_pitch_rad), GEAR, PINION)
+    # rolling (the big gear turned −φ·z_small/z_big when the small one turns φ): the same mesh
+    # again after one small-gear pitch of drive, not before
+    for fraction, same in ((0.3, False), (0.5, False), (1.0, True)):
+        phi = fraction * PINION.angular_pitch_rad
+        assert congruent(q, _pair(-phi * PINION.teeth / GEAR.teeth, phi), GEAR, PINION, tol=1e-7) is same
+
+
+def test_tooth_half_mask_keeps_one_flank_side_of_the_chosen_teeth():
+    # points on the flanks of every tooth, both sides, plus root-land points: the mask keeps the
+    # chosen side of the chosen teeth only (a "face" here is one point repeated)
+    from gearcheck.geometry.bevel_mesh import tooth_half_mask
+
+    def _unit(polar, azimuth):
+        return np.array([math.sin(polar) * math.cos(azimuth), math.sin(polar) * math.sin(azimuth), math.cos(polar)])
+
+    spec = GEAR
+    theta = 0.5 * (spec.root_angle_rad + spec.face_angle_rad)
+    r = spec.outer_cone_distance_mm
+    points, expect = [], []
+    for tooth in range(spec.teeth):
+        for side in (-1, 1):
+            az = float(flank_azimuth(spec, theta, side)) + tooth * spec.angular_pitch_rad
+            points.append(r * _unit(theta, az))
+            expect.append((tooth, side, True))
+        # the root land between tooth and tooth + 1
+        points.append(r * _unit(spec.root_angle_rad, (tooth + 0.5) * spec.angular_pitch_rad))
+        expect.append((tooth, 1, False))
+    vertices = np.array(points)
+    faces = np.repeat(np.arange(len(points))[:, None], 3, axis=1)
+    teeth = np.array([-1, 0, 1])  # −1 is tooth z − 1
+    for side in (-1, 1):
+        mask = tooth_half_mask(vertices, faces, spec, side, teeth)
+        wanted = [flank and s == side and t in (spec.teeth - 1, 0, 1) for t, s, flank in expect]
+        assert mask.tolist() == wanted

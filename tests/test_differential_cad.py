@@ -24,14 +24,13 @@ def _cone_faces_apexes(shape, semi_angle_rad):
 
 @pytest.fixture(scope="module", params=[0.0, 0.1])
 def assembly(request, templates_dir):
-    from gearcheck.mechanisms import load_template
-    from gearcheck.mechanisms.differential.parts import build_parts
-    from gearcheck.mechanisms.differential.poses import gear_specs
+    from gearcheck.design import load_template
+    from gearcheck.pipeline import build_parts
 
     shim = request.param
-    loaded = load_template(templates_dir / "zhurong_differential.toml", [f"shim.thickness_mm={shim}"])
-    parts = {p.name: p for p in build_parts(loaded.params)}
-    return shim, parts, gear_specs(loaded.params)
+    design = load_template(templates_dir / "zhurong_differential.toml", [f"shim.thickness_mm={shim}"])
+    assembly, parts = build_parts(design)
+    return shim, {p.name: p for p in parts}, assembly.layout.specs
 
 
 def test_every_solid_valid(assembly):

@@ -1,4 +1,4 @@
-"""The differential's analytical model (seed 000, eqs (1)–(11)) through the template and the CLI.
+"""The differential's analytical model (the paper's eqs (1)–(11)) through the template and the CLI.
 
 Paper figures are acceptance targets with tolerances: the paper prints one decimal (3.4′, 6.8′),
 so ±0.1′ per side and ±0.2′ total are its rounding plus the spread of the reconstructed lost
@@ -14,10 +14,13 @@ from pathlib import Path
 import pytest
 
 from gearcheck.cli import main
+from gearcheck.design import load_template
 from gearcheck.figures import figures_to_json
-from gearcheck.mechanisms import load_template
-from gearcheck.mechanisms.differential import SECTION, calc
+from gearcheck.mechanism import get as mechanism
 from gearcheck.params import ParamError
+
+DIFFERENTIAL = mechanism("differential")
+SECTION = DIFFERENTIAL.section
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "zhurong_differential.toml"
 
@@ -42,7 +45,7 @@ REQUIRED_KEYS = [
 
 def figures(*overrides: str) -> dict:
     loaded = load_template(TEMPLATE, list(overrides))
-    return figures_to_json(SECTION, calc(loaded.params))[SECTION]
+    return figures_to_json(SECTION, DIFFERENTIAL.analyse(loaded.params))[SECTION]
 
 
 @pytest.fixture(scope="module")
@@ -61,7 +64,7 @@ def test_cold_drop_matches_paper_in_printed_form(base):
 
 def test_clean_form_is_present_and_smaller(base):
     # The clean eq (9) weights the negative slide term (t1 < t2) by 1 instead of 2·tan 20° = 0.73,
-    # so it loses less: ≈3.32′ (reference.md §1); ±0.05′ covers rounding of the reconstruction.
+    # so it loses less: ≈3.32′; ±0.05′ covers rounding of the reconstruction.
     clean = base["clean_cold_drop_per_side_arcmin"]
     assert clean < base["cold_drop_per_side_arcmin"]
     assert clean == pytest.approx(3.32, abs=0.05)
@@ -100,9 +103,10 @@ def test_one_material_everywhere_loses_no_backlash():
     assert abs(f["cold_drop_per_side_arcmin"]) < 1e-9
 
 
-@pytest.mark.parametrize("shim_key, shim_mm, expected", [("0p05", 0.05, 2.92), ("0p10", 0.10, 5.84), ("0p15", 0.15, 8.76)])
+@pytest.mark.parametrize("shim_key, shim_mm, expected",
+                         [("0p05", 0.05, 2.92), ("0p10", 0.10, 5.84), ("0p15", 0.15, 8.76)])
 def test_shim_gain_per_side(base, shim_key, shim_mm, expected):
-    # Eq (11), reference.md §1: ≈58.4′ per mm per side; ±0.1′ is the print rounding.
+    # Eq (11): ≈58.4′ per mm per side; ±0.1′ is the print rounding.
     per_side = base[f"shim_gain_per_side_arcmin_at_{shim_key}mm"]
     assert per_side == pytest.approx(expected, abs=0.1)
     assert base[f"shim_gain_total_arcmin_at_{shim_key}mm"] == pytest.approx(2.0 * per_side, rel=1e-12)
@@ -140,9 +144,11 @@ def test_drop_is_proportional_to_temperature_drop(base):
     f = figures("operating.cold_C=-130")
     assert f["temperature_drop_K"] == pytest.approx(155.0)
     assert f["cold_drop_per_side_arcmin"] == pytest.approx(base["cold_drop_per_side_arcmin"] * 155.0 / 90.0, rel=1e-9)
-    assert f["clean_cold_drop_per_side_arcmin"] == pytest.approx(base["clean_cold_drop_per_side_arcmin"] * 155.0 / 90.0, rel=1e-9)
+    assert f["clean_cold_drop_per_side_arcmin"] == pytest.approx(
+        base["clean_cold_drop_per_side_arcmin"] * 155.0 / 90.0, rel=1e-9)
     # The storage figure at −130 °C must agree with a cold design point at −130 °C.
-    assert base["backlash_total_min_at_storage_min_arcmin"] == pytest.approx(f["cold_backlash_total_min_arcmin"], rel=1e-9)
+    assert base["backlash_total_min_at_storage_min_arcmin"] == pytest.approx(f["cold_backlash_total_min_arcmin"],
+                                                                             rel=1e-9)
     assert "cold_drop_per_side_arcmin" not in f.get("paper", {})  # the paper's 3.4′ is for 90 K
     same = figures("operating.cold_C=25")
     assert same["cold_drop_per_side_arcmin"] == 0.0

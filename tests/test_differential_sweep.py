@@ -1,5 +1,5 @@
 """Differential sweep: the exact-flank play model, the geometric thermal state, and (``cad``) the
-FCL mesh sweep checked against them (issue 10)."""
+FCL mesh sweep checked against them."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from gearcheck.geometry import bevel_play as bp
+from gearcheck.design import load_template
 from gearcheck.geometry.bevel import BevelGearSpec, mating_spec
-from gearcheck.mechanisms import load_template
 from gearcheck.mechanisms.differential import analyse_params
 from gearcheck.mechanisms.differential.poses import assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
@@ -73,7 +73,7 @@ def test_closing_normal_shift_is_decided_at_the_toe(nominal):
 
 
 def test_slide_along_the_pitch_element_loses_play_either_way(nominal):
-    # reference §1: a slide moves the gear's apex off the common apex, the mesh is no longer
+    # docs/differential.md: a slide moves the gear's apex off the common apex, the mesh is no longer
     # conjugate and neighbouring pairs close up — 30 µm either way loses ≈ 0.3–1′ where the
     # first-order model (clean eq 9) says ±2tan(θ/2)·t/(d1/2) = ±0.22′
     d = BIG.pitch_angle_rad
@@ -133,6 +133,21 @@ def test_contact_is_on_the_flanks_of_both_gears():
         for pose, spec in ((turned, BIG), (small.pose, SMALL)):
             local = np.linalg.inv(pose) @ np.append(c.point, 1.0)
             assert flank_distance(spec, local[:3])[0] < 1e-6
+
+
+def test_play_period_is_half_a_pitch_when_the_big_gear_is_odd():
+    # each big gear meets its two small gears 180° apart: half a tooth apart when z_big is odd, so
+    # its play repeats every half small-gear pitch; in phase when z_big is even (a whole pitch)
+    from gearcheck.geometry.bevel_mesh import play_period
+    from gearcheck.mechanisms.differential.poses import GearSpecs
+
+    for big_teeth, fraction in ((33, 0.5), (32, 1.0)):
+        small = BevelGearSpec(teeth=13, mate_teeth=big_teeth, module_mm=2.5, face_width_mm=14.0, profile_shift=0.39,
+                              thinning_mm=0.0155)
+        specs = GearSpecs(big=mating_spec(small, thinning_mm=0.0155), small=small)
+        built = assembly_poses(specs).as_dict()
+        period = play_period(built, BIG_GEARS, SMALL_GEARS, specs.big, specs.small)
+        assert period == pytest.approx(fraction * small.angular_pitch_rad, rel=1e-12)
 
 
 # -- thermal state --------------------------------------------------------------------------
@@ -210,7 +225,7 @@ def test_equal_ctes_lose_no_play(templates_dir):
 
 
 def test_exact_cold_drop_exceeds_the_paper_model(template):
-    # reference §1: with shim 0.10 the exact flanks lose ≈ 3.9–4.4′ per side over a tooth cycle,
+    # docs/differential.md: with shim 0.10 the exact flanks lose ≈ 3.9–4.4′ per side over a tooth cycle,
     # more than the first-order model's 3.39′ (paper form) — a finding, not a fit; 6 angles over
     # the half-pitch period of the shaft's play (z_big odd)
     specs = gear_specs(template)
@@ -225,18 +240,32 @@ def test_exact_cold_drop_exceeds_the_paper_model(template):
 # -- the mesh sweep (CAD) -------------------------------------------------------------------
 @pytest.mark.cad
 def test_mesh_sweep_agrees_with_the_exact_flanks(build_bodies):
-    from gearcheck.mechanisms.differential.check import run_check
+    import contextlib
 
-    loaded, _, bodies = build_bodies("zhurong_differential")
+    from gearcheck import pipeline
+
+    run = build_bodies("zhurong_differential")
     counted = []
-    result = run_check(loaded.params, bodies, progress=counted.append, angles_per_cycle=4, shims_mm=[0.0, 0.1])
+
+    class _Bar:
+        def update(self, n: int = 1) -> None:
+            counted.append(n)
+
+    @contextlib.contextmanager
+    def progress(_desc, _total=None, _unit=""):
+        yield _Bar()
+
+    result = pipeline.sweep(run.design, run.assembly, run.bodies, jobs=1, progress=progress,
+                            options={"angles_per_cycle": 4, "shims_mm": [0.0, 0.1]})
     s = result.summary
-    assert s["mesh_agrees_with_exact"] == 1
+    verdicts = {v.name: v for v in result.verdicts}
+    assert verdicts["mesh_agrees_with_exact"].passed
+    assert "mesh_agrees_with_exact" not in s  # the verdict only, not a duplicate in the summary
     assert s["max_mesh_exact_contact_deviation_arcmin"] <= s["mesh_error_bound_arcmin"] + 0.02 * 9.0
     # meshes overstate clearance (chords inside convex flanks), never by more than the bound
     assert s["geom_warm_play_min_arcmin"] >= s["exact_warm_play_min_arcmin"] - 1e-3
     assert s["geom_cold_play_min_arcmin"] > 0.0
-    assert s["verdict_pass"] == 1 and result.passed
+    assert result.passed
     # the finding: the geometry loses more than the paper's first-order model
     assert s["geom_cold_drop_per_side_arcmin"] > s["model_cold_drop_per_side_arcmin"]
     # no shim binds cold (the paper shims for this reason)

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
-from fuzz_support import BASE, TEMPLATE_DIR, TEMPLATES, validate_set
+from fuzz_support import BASE, design_of, validate_set
 from gearcheck.mechanisms.sampling import RandomDraw, sample
 from gearcheck.params import ParamError
 
@@ -42,9 +42,9 @@ def accepted_set(mech: str, seed: int):
 
 def build_and_check(mech: str, params) -> None:
     from gearcheck.cad.mesh import mesh_shape
-    from gearcheck.mechanisms import load_template
+    from gearcheck.pipeline import build_parts
 
-    parts = load_template(TEMPLATE_DIR / TEMPLATES[mech]).parts_module.build_parts(params)
+    _, parts = build_parts(design_of(mech, params))
     assert parts
     meshed = {}
     for part in parts:
@@ -88,21 +88,11 @@ def test_accepted_differential_sets_play_agrees_with_exact_model(seed):
     import tempfile
     from pathlib import Path
 
-    from gearcheck.cad.export import export_parts, sweep_bodies
-    from gearcheck.mechanisms.differential import check
+    from gearcheck import pipeline
 
-    params = accepted_set("differential", seed)
-    parts = load_template_parts("differential").build_parts(params)
+    design = design_of("differential", accepted_set("differential", seed))
     with tempfile.TemporaryDirectory() as tmp:
-        _, exported = export_parts(parts, Path(tmp), name="fuzz", mechanism="differential",
-                                   params_data={"mechanism": "differential"})
-    result = check.run_check(params, sweep_bodies(exported), angles_per_cycle=4,
-                             shims_mm=[params.shim.thickness_mm], workers=1)
-    verdicts = {v.key: v for v in result.verdicts}
-    assert verdicts["mesh_agrees_with_exact"].passed, verdicts["mesh_agrees_with_exact"].detail
-
-
-def load_template_parts(mech: str):
-    from gearcheck.mechanisms import load_template
-
-    return load_template(TEMPLATE_DIR / TEMPLATES[mech]).parts_module
+        run = pipeline.build(design, Path(tmp), tol_mm=0.01)
+    result = pipeline.sweep(design, run.assembly, run.bodies, jobs=1, options=design.impl.fuzz_options(design.params))
+    verdicts = {v.name: v for v in result.verdicts}
+    assert verdicts["mesh_agrees_with_exact"].passed, verdicts["mesh_agrees_with_exact"].measured

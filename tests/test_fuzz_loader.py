@@ -24,7 +24,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from gearcheck.cli import main
-from gearcheck.mechanisms import load_template
+from gearcheck.design import load_template
 from gearcheck.params import ParamError
 from gearcheck.params.common import MAX_NESTING
 

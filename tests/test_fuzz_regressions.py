@@ -1,4 +1,4 @@
-"""Sets `make fuzz` found failing, kept as regression tests (issue 11). Each set is written out
+"""Sets `make fuzz` found failing, kept as regression tests. Each set is written out
 whole, so a change of the sampler cannot lose it.
 
 * Differential, fuzz seed 100 (z 60/40, α 15.74°): the path of contact reaches 1.35 pitches from
@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from gearcheck.geometry import bevel_play as bp
-from gearcheck.mechanisms import mechanism_module
+from gearcheck.mechanism import get as mechanism
 from gearcheck.mechanisms.differential.poses import gear_specs
 from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.params import validate
@@ -62,7 +62,7 @@ STEERING_SEED_2000084 = {  # S2 2.8 mm above S4/S6: corner pushes faster than 1.
 
 
 def params_of(mech: str, body: dict):
-    return validate(mechanism_module(mech).Params, body, f"{mech}-regression.toml")
+    return validate(mechanism(mech).Params, body, f"{mech}-regression.toml")
 
 
 # --- math layer (fast) -----------------------------------------------------------------------
@@ -81,7 +81,7 @@ def test_long_contact_path_widens_the_exact_play_window(monkeypatch):
 
 
 def test_template_keeps_the_two_tooth_window(templates_dir):
-    from gearcheck.mechanisms import load_template
+    from gearcheck.design import load_template
 
     specs = gear_specs(load_template(templates_dir / "zhurong_differential.toml").params)
     assert bp.teeth_window(specs.big, specs.small) == 2  # path reaches 0.95 pitches
@@ -103,15 +103,15 @@ def test_a_slanted_top_never_pushes_the_rack():
 
 
 def test_paper_figures_only_for_the_papers_design(templates_dir):
-    from gearcheck.mechanisms import load_template
-    from gearcheck.mechanisms.steering.check import paper_figures
+    from gearcheck.design import load_template
+    from gearcheck.mechanisms.steering.report import paper_figures
 
     template = load_template(templates_dir / "nose_wheel_steering.toml").params
     other = params_of("steering", STEERING_SEED_2000084)
     assert paper_figures(template)["disengage_deg"] == an.PAPER["disengage_deg"]
     assert set(paper_figures(other).values()) == {None}
     # the calc table likewise: printed values beside the paper's design only
-    calc = mechanism_module("steering").calc
+    calc = mechanism("steering").analyse
     assert sum(f.paper is not None for f in calc(template)) >= 10
     assert all(f.paper is None for f in calc(other))
 
@@ -119,35 +119,31 @@ def test_paper_figures_only_for_the_papers_design(templates_dir):
 # --- mesh sweep against the model (CAD) ------------------------------------------------------
 
 def _swept(mech: str, body: dict, **kwargs):
-    from gearcheck.cad.export import export_parts, sweep_bodies
-    from gearcheck.mechanisms import load_template
+    from gearcheck import pipeline
+    from gearcheck.design import Design
 
-    params = params_of(mech, body)
-    template = {"differential": "zhurong_differential.toml", "steering": "nose_wheel_steering.toml"}[mech]
-    loaded = load_template(Path(__file__).resolve().parents[1] / "templates" / template)
-    parts = loaded.parts_module.build_parts(params)
+    design = Design(None, mech, params_of(mech, body), {"mechanism": mech, "name": "regression", **body})
     with tempfile.TemporaryDirectory() as tmp:
-        _, exported = export_parts(parts, Path(tmp), name="regression", mechanism=mech,
-                                   params_data={"mechanism": mech, **body})
-    return loaded.check_module.run_check(params, sweep_bodies(exported), **kwargs)
+        run = pipeline.build(design, Path(tmp), tol_mm=0.01)
+    return pipeline.sweep(design, run.assembly, run.bodies, jobs=1, options=kwargs)
 
 
 @pytest.mark.cad
 def test_long_contact_path_mesh_play_agrees():
-    result = _swept("differential", DIFFERENTIAL_SEED_100, angles_per_cycle=4, shims_mm=[0.357], workers=1)
-    verdicts = {v.key: v for v in result.verdicts}
-    assert verdicts["mesh_agrees_with_exact"].passed, verdicts["mesh_agrees_with_exact"].detail
+    result = _swept("differential", DIFFERENTIAL_SEED_100, angles_per_cycle=4, shims_mm=[0.357])
+    verdicts = {v.name: v for v in result.verdicts}
+    assert verdicts["mesh_agrees_with_exact"].passed, verdicts["mesh_agrees_with_exact"].measured
 
 
 @pytest.mark.cad
 @pytest.mark.parametrize("body, jams", [(STEERING_SEED_2000091, True), (STEERING_SEED_2000084, False)],
                          ids=["seed-2000091-steep-top-jams", "seed-2000084-fast-corner-push"])
 def test_slanted_tops_mesh_towing_curve_agrees(body, jams):
-    result = _swept("steering", body, workers=1)
-    verdicts = {v.key: v for v in result.verdicts}
-    assert verdicts["towing_curve"].passed, verdicts["towing_curve"].detail
+    result = _swept("steering", body)
+    verdicts = {v.name: v for v in result.verdicts}
+    assert verdicts["mesh_agrees_with_exact"].passed, verdicts["mesh_agrees_with_exact"].measured
     # the jam is a design failure both ways agree on, shown as interference on the return swing
-    assert verdicts["no_interference_reengage"].passed is (not jams), verdicts["no_interference_reengage"].detail
+    assert verdicts["no_interference_reengage"].passed is (not jams), verdicts["no_interference_reengage"].measured
     # another design than the paper's: no printed figure is shown beside it as if it were a target
     assert all(c.paper is None for c in result.comparisons)
     assert not any("paper" in label for plot in result.plots for label, x in plot.markers if x is not None)

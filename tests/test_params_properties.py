@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fuzz_support import NAN_ALLOWED, draw_set, validate_set
-from gearcheck.mechanisms import mechanism_module
+from gearcheck.mechanism import get as mechanism
 from gearcheck.params import ParamError
 
 PROPERTY = settings(derandomize=True, deadline=None, database=None,
@@ -28,7 +28,7 @@ def check_set(mech: str, data) -> bool:
     result = validate_set(mech, body)
     if isinstance(result, ParamError):
         return False
-    figures = mechanism_module(mech).calc(result)
+    figures = mechanism(mech).analyse(result)
     assert figures
     for f in figures:
         assert not math.isinf(f.value), f.key
@@ -69,7 +69,7 @@ def test_the_sampler_reaches_both_outcomes():
             body = sample(BASE[mech], RandomDraw(seed))
             del body["mechanism"]
             try:
-                validate(mechanism_module(mech).Params, body)
+                validate(mechanism(mech).Params, body)
                 outcomes.add("accepted")
             except ParamError:
                 outcomes.add("rejected")

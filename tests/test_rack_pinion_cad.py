@@ -1,6 +1,6 @@
-"""Nose-wheel steering pinion sector and trimmed rack (seed 003) as built solids: measurements
-on the B-rep (CadQuery/OCP, marked ``cad``; one module-scoped build), and the pure helpers the
-CAD module consumes (numpy, unmarked).
+"""Nose-wheel steering pinion sector and trimmed rack as built solids (the steering mechanism's
+parts hook): measurements on the B-rep (CadQuery/OCP, marked ``cad``; one module-scoped build),
+and the pure helpers the CAD module consumes (numpy, unmarked).
 
 Tolerances: the issue's acceptance tolerance is 0.01 mm on trims and tooth thickness and 1 µm on
 the flank; quantities the construction fixes exactly (axis, datum, frames) are held to 1 µm;
@@ -16,14 +16,14 @@ import math
 import numpy as np
 import pytest
 
+from gearcheck.design import load_template
 from gearcheck.geometry import rack_pinion as rp
-from gearcheck.mechanisms import load_template
 from gearcheck.mechanisms.steering import analysis
 
 from conftest import TEMPLATES
 
-ACCEPT_MM = 0.01  # issue 9: trimmed heights and pitch-circle tooth thickness
-FLANK_TOL_MM = 1e-3  # issue 9: flank ≤ 1 µm from the exact involute
+ACCEPT_MM = 0.01  # trimmed heights and pitch-circle tooth thickness
+FLANK_TOL_MM = 1e-3  # flank ≤ 1 µm from the exact involute
 EXACT_MM = 1e-6  # a dimension the construction fixes exactly (axis, datum, corners)
 CONTACT_TOL_MM = 1e-3  # zero backlash: nominal min distance below this counts as touching
 PAST_CONTACT_MM = 0.01  # pinion moved this far towards / away from the rack
@@ -33,8 +33,13 @@ FLANK_SAMPLES_U = 41  # per flank along the profile (× 3 heights = 123 points p
 
 
 @pytest.fixture(scope="module")
-def params():
-    return load_template(TEMPLATES / "nose_wheel_steering.toml").params
+def design():
+    return load_template(TEMPLATES / "nose_wheel_steering.toml")
+
+
+@pytest.fixture(scope="module")
+def params(design):
+    return design.params
 
 
 @pytest.fixture(scope="module")
@@ -48,7 +53,7 @@ def test_tooth_pieces_close_and_lie_on_the_exact_profile(geom):
     for j in (geom.sector_first_tooth, 0):
         pieces = rp.pinion_tooth_pieces(geom, j, 24, 24)
         assert [p.kind for p in pieces] == ["fillet", "involute", "tip", "involute", "fillet"]
-        for a, b in zip(pieces[:-1], pieces[1:]):  # shared end points, bit for bit
+        for a, b in zip(pieces[:-1], pieces[1:], strict=True):  # shared end points, bit for bit
             assert (a.rho[-1], a.gamma[-1]) == (b.rho[0], b.gamma[0])
         assert np.all(np.diff(np.concatenate([p.gamma for p in pieces])) >= 0)  # counter-clockwise
         for piece, side in ((pieces[1], -1), (pieces[3], +1)):
@@ -78,10 +83,17 @@ def test_involute_flank_distance_is_the_normal_offset(geom):
 # ----------------------------------------------------------------------- built solids (cad)
 
 @pytest.fixture(scope="module")
-def built(params):
-    from gearcheck.cad import rack_pinion as crp
+def assembly(design):
+    return design.impl.assembly(design.params)
 
-    return crp.steering_parts(params)
+
+@pytest.fixture(scope="module")
+def built(design, assembly):
+    """The parts hook's pinion and rack at angle 0 (φ = 0, L = 0)."""
+    from types import SimpleNamespace
+
+    parts = design.impl.parts(assembly)
+    return SimpleNamespace(parts=parts, **{p.name: p for p in parts})
 
 
 @pytest.fixture(scope="module")
@@ -138,9 +150,11 @@ def test_every_solid_is_valid(built):
 
 
 @pytest.mark.cad
-def test_pinion_volume_is_the_outline_area_times_face_width(built, geom):
+def test_pinion_volume_is_the_outline_area_times_face_width(built, geom, assembly):
     # The numpy outline (100-segment polylines, area error < 1e-4 mm²) minus the bore, times b.
-    from gearcheck.cad.rack_pinion import FACE_WIDTH_MM, PINION_BORE_DIAMETER_MM
+    spec = assembly.solids["pinion"]
+    FACE_WIDTH_MM, PINION_BORE_DIAMETER_MM = spec.face_width_mm, spec.bore_diameter_mm
+    assert (FACE_WIDTH_MM, PINION_BORE_DIAMETER_MM) == (30.0, 60.0)
 
     xy = geom.pinion_blank_outline(0.0, arc_segments=20000)
     x, y = xy[:, 0], xy[:, 1]
@@ -251,13 +265,13 @@ def test_centre_to_datum_is_H(built, geom, occ):
             datum.append(surf.Plane().Location().Y())
     assert len(datum) == 1
     assert rack.BoundingBox().ymin == pytest.approx(datum[0], abs=EXACT_MM)
-    assert axis_y - datum[0] == pytest.approx(107.0, abs=1e-3)  # issue 9: H = 107
+    assert axis_y - datum[0] == pytest.approx(107.0, abs=1e-3)  # H = 107
 
 
 @pytest.mark.cad
 def test_pinion_flanks_are_the_exact_involute(built, geom, occ):
     """All 32 involute flank faces, ≥ 100 points each (41 along the profile × 3 heights),
-    against the closed-form involute: |distance| ≤ 1 µm (issue 9)."""
+    against the closed-form involute: |distance| ≤ 1 µm."""
     pinion = built.pinion.solid
     tau = geom.angular_pitch
     worst, flanks, samples = 0.0, 0, 0
@@ -287,15 +301,19 @@ def test_pinion_flanks_are_the_exact_involute(built, geom, occ):
 
 
 @pytest.mark.cad
-def test_frames_match_the_geometry_at_another_pose(params, geom, occ):
-    """Pose as data: at φ = 0.3 rad and L = 17 mm, the numpy model's tip corners S1/S3 and the
-    trimmed corners S2…S8 lie on the boundary of the placed solids."""
-    from gearcheck.cad import rack_pinion as crp
+def test_frames_match_the_geometry_at_another_pose(built, geom, occ):
+    """Pose as data: at φ = 0.3 rad and L = 17 mm (each part moved by its typed motion from its
+    pose as built, as the sweep moves it), the numpy model's tip corners S1/S3 and the trimmed
+    corners S2…S8 lie on the boundary of the placed solids."""
+    import dataclasses
 
     phi, travel = 0.3, 17.0
-    parts = crp.steering_parts(params, phi, travel)
-    pinion = occ.BRepClass3d_SolidClassifier(parts.pinion.placed().wrapped)
-    rack = occ.BRepClass3d_SolidClassifier(parts.rack.placed().wrapped)
+    moved_pinion = dataclasses.replace(built.pinion, pose=built.pinion.motion.matrix(phi) @ built.pinion.pose)
+    moved_rack = dataclasses.replace(built.rack, pose=built.rack.motion.matrix(travel) @ built.rack.pose)
+    np.testing.assert_allclose(moved_pinion.pose, rp.pinion_pose(geom, phi), atol=1e-12)
+    np.testing.assert_allclose(moved_rack.pose, rp.rack_pose(travel), atol=1e-12)
+    pinion = occ.BRepClass3d_SolidClassifier(moved_pinion.placed().wrapped)
+    rack = occ.BRepClass3d_SolidClassifier(moved_rack.placed().wrapped)
     first = geom.sector_first_tooth
     corners = [(pinion, geom.pinion_tip_corner(j, phi, side)) for j in (first, first + 1, geom.sector_last_tooth)
                for side in (-1, 1)]

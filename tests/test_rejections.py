@@ -1,4 +1,4 @@
-"""Every rejection issue 11 lists, one test each, on the shipped templates with `--set`: the
+"""Every rejection found by the reliability review, one test each, on the shipped templates with `--set`: the
 error is one ParamError line naming the exact field, its value and an allowed range.
 
 The rejections that stand in for a CAD failure also show the failure they prevent: the same set,
@@ -14,7 +14,9 @@ import re
 
 import pytest
 
-from gearcheck.mechanisms import load_template, mechanism_module
+from gearcheck.design import load_template
+from gearcheck.mechanism import get as mechanism
+from gearcheck.mechanisms.steering import analysis as steering_analysis
 from gearcheck.params import ParamError
 from gearcheck.params.common import apply_overrides, read_toml
 
@@ -54,7 +56,7 @@ def unchecked(templates_dir, name: str, *overrides: str):
     """The Params object of a template and overrides built WITHOUT validation (what the CAD would
     receive if the model did not reject the set)."""
     data = apply_overrides(read_toml(templates_dir / name), list(overrides))
-    model = mechanism_module(data["mechanism"]).Params
+    model = mechanism(data["mechanism"]).Params
     sections = {k: model.model_fields[k].annotation.model_construct(**v) for k, v in data.items() if k != "mechanism"}
     return model.model_construct(**sections)
 
@@ -99,10 +101,10 @@ def test_pointed_steering_pinion(templates_dir):
     overrides = ["pinion.profile_shift=1.0", "pinion.addendum_coefficient=1.5", "rack.dedendum_coefficient=2"]
     exc = assert_rejects(templates_dir, STEER, overrides, "pinion.addendum_coefficient", "pointed", "0.25·m")
     ha = bound(exc, "<=")
-    g = mechanism_module("steering").analysis.geometry_from_params(unchecked(templates_dir, STEER, *overrides))
+    g = steering_analysis.geometry_from_params(unchecked(templates_dir, STEER, *overrides))
     assert 2 * g.tip_radius * float(g.involute_half_angle(g.tip_radius)) < 0.25 * g.module_mm
     # just inside the bound the tip land is at least 0.25·m
-    g_ok = mechanism_module("steering").analysis.with_inputs(g, pinion_addendum_coefficient=ha - 1e-6)
+    g_ok = steering_analysis.with_inputs(g, pinion_addendum_coefficient=ha - 1e-6)
     assert 2 * g_ok.tip_radius * float(g_ok.involute_half_angle(g_ok.tip_radius)) >= 0.25 * g.module_mm - 1e-9
 
 
@@ -114,7 +116,7 @@ def test_pointed_rack_teeth(templates_dir):
 # -------------------------------------------------------------------- contact ratio
 def test_contact_ratio_below_one_at_the_trim(templates_dir):
     exc = assert_rejects(templates_dir, STEER, ["trim.hS4_mm=24.0"], "trim.hS4_mm", "contact ratio >= 1")
-    an = mechanism_module("steering").analysis
+    an = steering_analysis
     g = an.geometry_from_params(unchecked(templates_dir, STEER, "trim.hS4_mm=24.0"))
     assert an.contact_ratio(g, 24.0) < 1.0
     low = float(re.search(r"allowed >([\d.]+) to", exc.allowed).group(1))
@@ -152,7 +154,7 @@ def test_negative_warm_backlash(templates_dir):
 # ---------------------------------------------------- trims the pinion tip cannot clear
 def test_trim_s8_above_the_tip_circle_tangent(templates_dir):
     exc = assert_rejects(templates_dir, STEER, ["trim.hS8_mm=26.9"], "trim.hS8_mm", "cannot clear")
-    calc = {f.key: f.value for f in load_template(templates_dir / STEER).module.calc(load_template(templates_dir / STEER).params)
+    calc = {f.key: f.value for f in load_template(templates_dir / STEER).calc().figures
             if f.key == "hS8_max_mm"}
     assert bound(exc, "to") == pytest.approx(calc["hS8_max_mm"], abs=1e-3)  # the figure calc reports
     load_template(templates_dir / STEER, [f"trim.hS8_mm={bound(exc, 'to') - 0.01:.3f}"])
@@ -305,7 +307,7 @@ def test_pinion_root_circle_must_clear_its_bore(templates_dir):
     from gearcheck.mechanisms.steering import layout
 
     exc = assert_rejects(templates_dir, STEER, ["pinion.module_mm=1"], "pinion.teeth", "60 mm pinion bore")
-    g = mechanism_module("steering").analysis.geometry_from_params(unchecked(templates_dir, STEER, "pinion.module_mm=1"))
+    g = steering_analysis.geometry_from_params(unchecked(templates_dir, STEER, "pinion.module_mm=1"))
     assert not layout.bore_fits(g.root_radius)
     assert bound(exc, ">=") == 63  # r − 1.25·m > 30 mm at m = 1: z > 62.5
 
@@ -317,7 +319,7 @@ def test_pinion_root_land_needs_a_blunt_cutter(templates_dir):
     exc = assert_rejects(templates_dir, STEER, ["pinion.dedendum_coefficient=1.8"], "pinion.dedendum_coefficient",
                          "no root land")
     assert bound(exc, "<") == pytest.approx(math.pi / 4 / math.tan(math.radians(25)), abs=1e-3)
-    g = mechanism_module("steering").analysis.geometry_from_params(
+    g = steering_analysis.geometry_from_params(
         unchecked(templates_dir, STEER, "pinion.dedendum_coefficient=1.8"))
     assert pinion_root_land_start(g) > g.angular_pitch / 2  # the root lands of neighbours overlap
 
@@ -325,7 +327,7 @@ def test_pinion_root_land_needs_a_blunt_cutter(templates_dir):
 def test_rack_teeth_must_leave_a_root_space(templates_dir):
     exc = assert_rejects(templates_dir, STEER, ["rack.dedendum_coefficient=1.8"], "rack.dedendum_coefficient",
                          "no tooth space")
-    g = mechanism_module("steering").analysis.geometry_from_params(
+    g = steering_analysis.geometry_from_params(
         unchecked(templates_dir, STEER, "rack.dedendum_coefficient=1.8"))
     left, right = g.rack_tooth_polygon(0), g.rack_tooth_polygon(1)
     assert left[1, 0] > right[0, 0]  # bottom-right of one tooth beyond bottom-left of the next

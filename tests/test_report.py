@@ -7,24 +7,25 @@ import math
 
 from gearcheck.report.files import summary_json, sweep_csv
 from gearcheck.report.html import render
-from gearcheck.sweep.result import CheckResult, Comparison, Plot, Series, Verdict
+from gearcheck.results import CheckResult, Comparison, Confirmation, Plot, Series, Verdict
 
 
-def sample(passed=True):
+def sample(passed=True, confirmed=False):
     return CheckResult(
         section="demo",
         summary={"play_min_arcmin": 1.25, "study": {"shims_mm": [0.0, 0.1]}, "nan_figure": math.nan, "flag": True},
-        verdicts=[Verdict("no_interference", "no interference", passed, "min clearance 0.012 mm")],
+        verdicts=[Verdict.of("no_interference", "no interference", passed, "min clearance 0.012 mm")],
         rows=[{"angle_deg": 0.0, "play": 1.0}, {"angle_deg": 0.5, "play": 1.1, "extra": "x"}],
         comparisons=[Comparison("drop", "arcmin", 3.4, 3.39, None, "paper form", exact=4.1)],
         plots=[Plot("play", "angle", "arcmin", [Series("warm", [0, 1], [1, 2])], markers=[("stop", 0.5)])],
         notes=["a finding"],
+        confirmations=[Confirmation("worst pose", "worst", "a / b", 0.1, 0.099, 0.02)] if confirmed else [],
     )
 
 
 def test_summary_is_plain_numeric_and_deterministic():
-    text = summary_json(sample(), {"worst": {"mesh_mm": 0.1, "brep_mm": 0.099, "bound_mm": 0.02}})
-    assert text == summary_json(sample(), {"worst": {"mesh_mm": 0.1, "brep_mm": 0.099, "bound_mm": 0.02}})
+    text = summary_json(sample(confirmed=True))
+    assert text == summary_json(sample(confirmed=True))
     data = json.loads(text)["demo"]
     assert data["verdict_pass"] == 1 and data["verdicts"] == {"no_interference": 1}
     assert data["nan_figure"] is None and data["flag"] == 1
@@ -40,8 +41,7 @@ def test_sweep_csv_has_one_row_per_pose_and_all_columns():
 
 
 def test_html_shows_verdict_tables_and_inline_plots():
-    page = render(sample(passed=False), title="t", template="x.toml", build={}, confirmations={
-        "worst": {"parts": "a / b", "mesh_mm": 0.1, "brep_mm": 0.099, "bound_mm": 0.02}})
+    page = render(sample(passed=False, confirmed=True), title="t", template="x.toml", build={})
     assert "FAIL" in page and "0 of 1 verdicts pass" in page
     assert page.count("<svg") == 1 and "http://" not in page.split("<svg", 1)[0]
     assert "3.4000" in page and "4.1000" in page and "a finding" in page

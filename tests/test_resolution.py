@@ -6,8 +6,9 @@ from dataclasses import dataclass
 import pytest
 
 from gearcheck.params import ParamError
-from gearcheck.sweep.resolution import describe, enforce, resolution_summary
-from gearcheck.sweep.result import CheckResult, Clearance
+from gearcheck.pipeline import apply_resolution_rule
+from gearcheck.resolution import describe, resolution_summary, violation
+from gearcheck.results import CheckResult, Clearance
 
 
 @dataclass
@@ -19,14 +20,19 @@ def result_with(clearance):
     return CheckResult("x", {}, [], [], smallest_clearance=clearance)
 
 
+@dataclass
+class FakeDesign:
+    source: str = "t.toml"
+
+
 BODIES = {"gear_a": FakeBody(0.003), "gear_b": FakeBody(0.0025)}
 
 
 def test_bound_within_a_tenth_passes():
     result = result_with(Clearance(0.030, "least play"))
-    enforce(result, BODIES, 0.003)  # 0.003 ≤ 0.030 / 10: equality is allowed
+    assert violation(result, BODIES) is None  # 0.003 ≤ 0.030 / 10: equality is allowed
     figures = resolution_summary(result, BODIES)
-    assert figures == {"mesh_error_bound_mm": 0.003, "smallest_clearance_mm": 0.030,
+    assert figures == {"largest_part_error_bound_mm": 0.003, "smallest_clearance_mm": 0.030,
                        "allowed_bound_mm": pytest.approx(0.003), "rule_met": 1}
     assert "gear_a" in describe(result, BODIES)
 
@@ -34,7 +40,7 @@ def test_bound_within_a_tenth_passes():
 def test_bound_above_a_tenth_is_a_tol_error():
     result = result_with(Clearance(0.0299, "least cold play per side"))
     with pytest.raises(ParamError) as err:
-        enforce(result, BODIES, 0.003, "t.toml")
+        apply_resolution_rule(FakeDesign(), result, BODIES, 0.003)
     text = str(err.value)
     assert "\n" not in text
     assert text.startswith("t.toml: --tol = 0.003: allowed ≤ 0.00299 mm")
@@ -44,22 +50,22 @@ def test_bound_above_a_tenth_is_a_tol_error():
 
 def test_no_clearance_checked_means_no_rule():
     result = result_with(None)
-    enforce(result, {"pinion": FakeBody(0.5)}, 0.5)
-    assert resolution_summary(result, {"pinion": FakeBody(0.5)}) == {"mesh_error_bound_mm": 0.5, "rule_met": 1}
+    apply_resolution_rule(FakeDesign(), result, {"pinion": FakeBody(0.5)}, 0.5)
+    assert result.summary["mesh_resolution"] == {"largest_part_error_bound_mm": 0.5, "rule_met": 1}
     assert "no non-zero clearance" in describe(result, {"pinion": FakeBody(0.5)})
 
 
 def test_tol_help_names_each_mechanisms_default():
-    """`--help` spells the per-mechanism defaults out (the CLI does not import the mechanisms just
-    to print help): they must be the values the build uses."""
+    """`check --help` spells each registered mechanism's default tolerance out (read from the
+    mechanism when the help is shown): the values the build uses."""
     import re
 
     from gearcheck.cli import build_parser
-    from gearcheck.mechanisms import MECHANISMS, mechanism_module
+    from gearcheck.mechanism import all_mechanisms
 
     parser = build_parser()
     check = next(a for a in parser._subparsers._group_actions[0].choices.values() if a.prog.endswith("check"))
-    text = " ".join(next(a.help for a in check._actions if a.dest == "tol").split())
-    for name in MECHANISMS:
-        found = re.search(rf"{name} ([0-9.]+)", text)
-        assert found and float(found.group(1)) == mechanism_module(name).MESH_TOL_MM, name
+    text = " ".join(check.format_help().split())
+    for mech in all_mechanisms():
+        found = re.search(rf"{mech.name} ([0-9.]+)", text)
+        assert found and float(found.group(1)) == mech.mesh_tol_mm, mech.name

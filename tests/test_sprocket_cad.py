@@ -1,7 +1,7 @@
-"""Track-drive sprocket and chain (seed 002): the pose math (numpy) and measurements on the built
+"""Track-drive sprocket and chain: the pose math (numpy) and measurements on the built
 solids (CadQuery/OCP, marked ``cad``; one module-scoped build, exact B-rep distances).
 
-Tolerances: B-rep distances (BRepExtrema) and face geometry are exact to ~1e-7 mm; the issue's
+Tolerances: B-rep distances (BRepExtrema) and face geometry are exact to ~1e-7 mm; the
 acceptance tolerance is 0.01 mm, and the "both sides" checks move a body 0.02 mm past contact.
 """
 
@@ -14,12 +14,12 @@ import pytest
 
 from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
-from gearcheck.mechanisms import load_template
+from gearcheck.design import load_template
 from gearcheck.mechanisms.track import analysis
 
 from conftest import TEMPLATES
 
-ACCEPT_MM = 0.01  # the issue's tolerance on chord, gap
+ACCEPT_MM = 0.01  # the acceptance tolerance on chord, gap
 EXACT_MM = 1e-6  # B-rep measurement of a quantity the construction fixes exactly
 PAST_CONTACT_MM = 0.02  # how far a body is pushed past (or short of) contact
 
@@ -113,6 +113,41 @@ def test_link_geometry_plate_clears_the_next_sleeve_and_covers_the_teeth(params,
         tc.link_geometry(30.0, 8.0, 4.5, 60.0)  # e beyond the sleeve radius: sleeve cannot join the plate
 
 
+def test_assembly_specs_poses_and_motions(params, wrap):
+    """The mechanism's assembly (numpy only): the sprocket, then link_00 … link_NN posed by the
+    default wrap at θ = 0, each link a copy of one link solid with plate and sleeve features."""
+    from gearcheck.geometry.sprocket import SprocketSpec
+    from gearcheck.mechanism import get
+    from gearcheck.sweep.motion import ChainLink, Rotation
+
+    assembly = get("track").assembly(params)
+    assert assembly.names == ["sprocket"] + [f"link_{j:02d}" for j in range(wrap.links)]
+    sprocket, links = assembly.parts[0], assembly.parts[1:]
+    assert sprocket.solid == "sprocket" and sprocket.material == "7075-T651 aluminium alloy"
+    assert sprocket.color == (0.75, 0.75, 0.8) and sprocket.features == ()
+    assert sprocket.motion == Rotation.about((0, 0, 1), (0, 0, 0))
+    assert np.array_equal(sprocket.pose, tc.sprocket_matrix(0.0))
+    poses = wrap.link_matrices(0.0)
+    for j, link in enumerate(links):
+        assert link.solid == "link" and link.material == "cast aluminium track link with steel sleeve"
+        assert link.color == (0.3, 0.3, 0.35) and link.features == ("plate", "sleeve")
+        assert link.motion == ChainLink(j) and np.array_equal(link.pose, poses[j])
+    assert isinstance(assembly.solids["sprocket"], SprocketSpec)
+    assert assembly.solids["link"] == assembly.layout.link and assembly.layout.wrap == wrap
+    assert assembly.solids["sprocket"].gap.pitch_radius_mm == pytest.approx(wrap.pin_radius_mm, abs=1e-12)
+
+
+@pytest.mark.cad
+def test_cad_module_imports_no_mechanism():
+    """Solids are built from data specs: gearcheck.cad.sprocket never imports a mechanism."""
+    import subprocess
+    import sys
+
+    code = ("import sys, gearcheck.cad.sprocket; "
+            "sys.exit(any(m.startswith('gearcheck.mechanisms') for m in sys.modules))")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
 # ---------------------------------------------------------------- solids (CadQuery / OCP)
 
 def _distance(a, b):
@@ -159,9 +194,25 @@ def _shift(matrix, dx, dy):
 
 @pytest.fixture(scope="module")
 def built(params):
-    from gearcheck.cad import sprocket as cs
+    """The mechanism's own composition: ``assembly()`` (data) then ``parts()`` (its CAD hook)."""
+    import time
+    from types import SimpleNamespace
 
-    parts = cs.track_drive_parts(params, 0.0)
+    from gearcheck.cad.sprocket import LinkSolids
+    from gearcheck.mechanism import get
+
+    impl = get("track")
+    assembly = impl.assembly(params)
+    t0 = time.perf_counter()
+    built_parts = impl.parts(assembly)
+    build_s = time.perf_counter() - t0
+    sprocket, links = built_parts[0], built_parts[1:]
+    first = links[0]
+    parts = SimpleNamespace(
+        assembly=assembly, parts=built_parts, sprocket=sprocket, links=links,
+        link_solids=LinkSolids(first.solid, first.features["plate"], first.features["sleeve"]),
+        sprocket_spec=assembly.solids["sprocket"], link_geometry=assembly.solids["link"],
+        seated_links=lambda: assembly.layout.wrap.seated_links(0.0), build_s=build_s)
     return parts, parts.sprocket.placed()
 
 
@@ -172,7 +223,16 @@ def test_every_solid_is_valid(built):
         assert s.isValid()
     for part in parts.parts:
         assert part.placed().isValid() and len(part.solid.Solids()) == 1, part.name
-    assert parts.build_s["sprocket"] < 10.0
+    assert parts.build_s < 10.0  # sprocket and link together
+    # parts in the assembly's order, posed as its specs say; one link solid (and its features) shared
+    assert [p.name for p in parts.parts] == parts.assembly.names
+    for part, spec in zip(parts.parts, parts.assembly.parts, strict=True):
+        assert np.array_equal(part.pose, spec.pose) and part.material == spec.material and part.color == spec.color
+        assert part.motion == spec.motion and set(part.features) == set(spec.features)
+    for part in parts.links:
+        assert part.solid is parts.link_solids.link
+        assert part.features["plate"] is parts.link_solids.plate and part.features["sleeve"] is parts.link_solids.sleeve
+    assert parts.sprocket.features == {}
 
 
 @pytest.mark.cad
@@ -229,7 +289,7 @@ def test_chord_between_seated_sleeve_centres(built, params):
     parts, placed_sprocket = built
     seated = parts.seated_links()
     centres = []
-    for j, part in enumerate(parts.links):
+    for part in parts.links:
         sleeve = place(parts.link_solids.sleeve, part.pose)
         (axis,) = [c for _, c, _, _ in _cylinders(sleeve)]
         centres.append(axis)

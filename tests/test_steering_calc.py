@@ -1,7 +1,7 @@
-"""Nose-wheel steering rack and pinion (seed 003): `gearcheck calc` against the paper and the
-reference reconstruction, and the push model against the closed forms.
+"""Nose-wheel steering rack and pinion: `gearcheck calc` against the paper and the reference
+reconstruction (docs/steering.md), and the push model against the closed forms.
 
-Targets and tolerances: reference.md §3 "clean model" numbers (m = 4, zero backlash, machined
+Targets and tolerances: the reconstruction's "clean model" numbers (m = 4, zero backlash, machined
 trims). ±0.05 mm / ±0.1° are the reference's stated accuracy of its own check numbers; the
 cross-checks between the two independent models use 1 µm (measured polyline error ≤ 0.04 µm).
 """
@@ -17,9 +17,8 @@ import numpy as np
 import pytest
 
 from gearcheck.cli import main
-from gearcheck.mechanisms import load_template
+from gearcheck.design import load_template
 from gearcheck.mechanisms.steering import analysis as an
-from gearcheck.mechanisms.steering import calc
 from gearcheck.params import ParamError
 
 TEMPLATE = Path(__file__).resolve().parents[1] / "templates" / "nose_wheel_steering.toml"
@@ -30,8 +29,8 @@ SOLVED_CHAIN = {"hS4_mm", "travel_S3S4_solved_mm", "hS2_solved_mm"}
 
 
 def _figures(overrides=None) -> dict:
-    loaded = load_template(TEMPLATE, overrides or [])
-    return {f.key: f.value for f in calc(loaded.params)}
+    design = load_template(TEMPLATE, overrides or [])
+    return {f.key: f.value for f in design.calc().figures}
 
 
 @pytest.fixture(scope="module")

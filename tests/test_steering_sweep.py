@@ -1,18 +1,24 @@
-"""Steering sweeps on the built meshes (issue 10): towing and power mode against the exact-polyline
-push model and the closed forms of ``analysis`` — and a trimmed rack the check must reject.
+"""Steering sweeps on the built meshes: towing and power mode against the exact-polyline push model
+and the closed forms of ``analysis`` — and a trimmed rack the check must reject.
 
 Reference values (docs/steering.md, clean model as machined): disengage 76.01° at 110.18 mm,
 re-engage 74.06°, G1's tip land grazes S2 for 4.10°, power-mode contact reaches S6 at 62.33°.
 """
 
+import dataclasses
+import json
 import math
 
 import numpy as np
 import pytest
 
-from gearcheck.mechanisms import load_template
+from gearcheck import pipeline
+from gearcheck.design import load_template
+from gearcheck.geometry.rack_pinion_power import power_model_angle, power_model_travel, tangency_offset
 from gearcheck.mechanisms.steering import analysis as an
-from gearcheck.mechanisms.steering import check as ck
+from gearcheck.mechanisms.steering.tasks import Kinematics
+from gearcheck.mechanisms.steering.verdicts import TOWING_CURVE_TOL_MM
+from gearcheck.report.files import summary_json
 
 TEMPLATE = "nose_wheel_steering"
 # Coarser than the default 0.25°: every event is bisected between grid poses, so the step only
@@ -57,7 +63,7 @@ def test_tangency_offset_finds_the_touching_point_between_mesh_vertices():
             touching = centre - radius * normal
             corner = touching + 0.7 * up
             vertex = polygon[np.argmin(polygon @ normal)]
-            offset = ck.tangency_offset(polygon, vertex, normal, corner, up)
+            offset = tangency_offset(polygon, vertex, normal, corner, up)
             worst_estimate = max(worst_estimate, abs(offset + 0.7))
             worst_vertex = max(worst_vertex, abs(up @ (vertex - corner) + 0.7))
     assert worst_estimate < 1e-4
@@ -68,27 +74,37 @@ def test_power_model_leaves_the_conjugate_line_tangentially_at_S6(templates_dir)
     """Rack drives: L = r·φ up to φS6 (eq 19); then the S6 corner rides the involute and the
     pinion lags, with the same slope at the junction (which is why a lag threshold cannot find
     it), growing with the square of the overshoot."""
-    params = load_template(templates_dir / f"{TEMPLATE}.toml").params
+    params = load_template(templates_dir / f"{TEMPLATE}.toml", []).params
     g = an.geometry_from_params(params)
     r = g.pitch_radius
     end = an.continuous_power_angle(g) * r
     h = 1e-4
-    assert ck.power_model_angle(g, end + h) == pytest.approx(end / r + h / r, abs=1e-9)
-    slope_after = (ck.power_model_angle(g, end + 2 * h) - ck.power_model_angle(g, end + h)) / h
+    assert power_model_angle(g, end + h) == pytest.approx(end / r + h / r, abs=1e-9)
+    slope_after = (power_model_angle(g, end + 2 * h) - power_model_angle(g, end + h)) / h
     assert slope_after == pytest.approx(1.0 / r, rel=1e-3)
-    lag_1, lag_2 = (((end + d) / r - ck.power_model_angle(g, end + d)) for d in (1.0, 2.0))
+    lag_1, lag_2 = (((end + d) / r - power_model_angle(g, end + d)) for d in (1.0, 2.0))
     assert lag_1 > 0 and lag_2 / lag_1 == pytest.approx(4.0, rel=0.1)
     for travel in (10.0, end - 0.1, end + 0.5, end + 8.0):
-        assert ck.power_model_travel(g, ck.power_model_angle(g, travel)) == pytest.approx(travel, abs=1e-8)
+        assert power_model_travel(g, power_model_angle(g, travel)) == pytest.approx(travel, abs=1e-8)
 
 
 # --------------------------------------------------------------------------- on the meshes
 
+def _sweep(run, assembly=None, bodies=None, step_deg: float = TEST_STEP_DEG):
+    return pipeline.sweep(run.design, assembly or run.assembly, bodies or run.bodies, jobs=1,
+                          options={"towing_step_deg": step_deg, "power_step_deg": step_deg})
+
+
+def _written(result) -> dict:
+    """The steering section of summary.json as the check writes it (verdicts and verdict_pass
+    included)."""
+    return json.loads(summary_json(result))["steering"]
+
+
 @pytest.fixture(scope="module")
 def checked(build_bodies):
-    loaded, _, bodies = build_bodies(TEMPLATE)
-    result = ck.run_check(loaded.params, bodies, towing_step_deg=TEST_STEP_DEG, power_step_deg=TEST_STEP_DEG)
-    return loaded.params, bodies, result
+    run = build_bodies(TEMPLATE)
+    return run.design.params, run.bodies, _sweep(run)
 
 
 def _both(summary):
@@ -97,11 +113,14 @@ def _both(summary):
 
 @pytest.mark.cad
 def test_sweep_poses_are_the_cad_poses(build_bodies):
-    from gearcheck.cad.rack_pinion import pinion_pose, rack_pose
+    from gearcheck.geometry.rack_pinion import pinion_pose, rack_pose
 
-    loaded, _, bodies = build_bodies(TEMPLATE)
-    g = an.geometry_from_params(loaded.params)
-    kin = ck.Kinematics.from_bodies(bodies["pinion"], bodies["rack"])
+    run = build_bodies(TEMPLATE)
+    g = an.geometry_from_params(run.design.params)
+    kin = Kinematics.of(run.assembly)
+    # the meshed bodies sit where the kinematics put them at angle 0 / travel 0 (the CAD poses)
+    np.testing.assert_allclose(run.bodies["pinion"].pose, kin.pinion(0.0), atol=1e-12)
+    np.testing.assert_allclose(run.bodies["rack"].pose, kin.rack(0.0), atol=1e-12)
     for phi in (0.0, 0.3, -1.2, math.radians(76.0)):
         np.testing.assert_allclose(kin.pinion(phi), pinion_pose(g, phi), atol=1e-12)
     for travel in (0.0, 12.5, -110.2):
@@ -119,14 +138,15 @@ def test_rack_stops_where_the_push_model_says(checked):
         assert s["geom_rack_travel_at_disengage_mm"] == pytest.approx(tow.travel_at_disengage_mm, abs=TRAVEL_TOL_MM)
         # it then stands: only the tip land's chord vertices nudge it, within the contact tolerance
         assert 0.0 <= s["geom_rack_motion_after_disengage_mm"] <= result.summary["contact_tolerance_mm"]
-        assert s["geom_grazing_span_deg"] == pytest.approx(math.degrees(tow.grazing_end_rad - tow.disengage_rad), abs=EVENT_TOL_DEG)
+        assert s["geom_grazing_span_deg"] == pytest.approx(math.degrees(tow.grazing_end_rad - tow.disengage_rad),
+                                                           abs=EVENT_TOL_DEG)
         assert s["geom_reengage_angle_deg"] == pytest.approx(math.degrees(tow.reengage_rad), abs=EVENT_TOL_DEG)
 
 
 @pytest.mark.cad
 def test_towing_curve_agrees_with_the_push_model(checked):
     params, _, result = checked
-    assert result.summary["max_towing_curve_deviation_mm"] <= ck.TOWING_CURVE_TOL_MM
+    assert result.summary["max_towing_curve_deviation_mm"] <= TOWING_CURVE_TOL_MM
     towing = [r for r in result.rows if r["mode"] == "towing"]
     swings = {(r["direction"], r["swing"]) for r in towing}
     assert swings == {(1, "out"), (1, "back"), (-1, "out"), (-1, "back")}
@@ -174,15 +194,15 @@ def test_continuous_drive_limit_is_where_the_contact_reaches_S6(checked):
     for s in _both(result.summary):
         assert s["geom_continuous_angle_deg"] == pytest.approx(model, abs=CONTINUOUS_TOL_DEG)
         assert s["geom_continuous_angle_deg"] >= params.targets.continuous_angle_deg
-        assert s["max_power_curve_deviation_mm"] <= ck.TOWING_CURVE_TOL_MM
+        assert s["max_power_curve_deviation_mm"] <= TOWING_CURVE_TOL_MM
 
 
 @pytest.mark.cad
 def test_verdicts_and_result_shape(checked):
     _, _, result = checked
-    assert result.passed and result.summary["verdict_pass"] == 1
-    assert {v.key for v in result.verdicts} >= {"continuous_drive", "rack_stops", "no_interference_past_disengage",
-                                                 "no_interference_reengage", "towing_curve"}
+    assert result.passed and _written(result)["verdict_pass"] == 1
+    assert {v.name for v in result.verdicts} >= {"continuous_drive", "rack_stops", "no_interference_past_disengage",
+                                                  "no_interference_reengage", "mesh_agrees_with_exact"}
     keys = set(result.rows[0])
     assert all(set(r) == keys for r in result.rows)
     assert {"mode", "direction", "pinion_angle_deg", "rack_travel_geom_mm", "rack_travel_model_mm",
@@ -201,22 +221,26 @@ def test_verdicts_and_result_shape(checked):
 
 
 @pytest.mark.cad
-def test_a_rack_mounted_too_close_jams_and_is_reported(checked):
+def test_a_rack_mounted_too_close_jams_and_is_reported(checked, build_bodies):
     """The same meshes with the rack raised 0.1 mm towards the pinion (centre distance short): a
     zero-backlash mesh then has no room, each pinion tooth overlaps its rack space by 2·0.1·tan α
     along the travel (0.093 mm). The check must report interference of that depth."""
-    from gearcheck.sweep.engine import Body
+    from gearcheck.sweep.bodies import Body
 
     params, bodies, _ = checked
+    run = build_bodies(TEMPLATE)
     raise_mm = 0.1
     rack = bodies["rack"]
     pose = np.array(rack.pose, float)
     pose[1, 3] += raise_mm
     moved = dict(bodies, rack=Body(rack.mesh, pose, rack.error_bound_mm, rack.material, rack.motion))
-    result = ck.run_check(params, moved, towing_step_deg=2.0, power_step_deg=2.0)
-    verdicts = {v.key: v.passed for v in result.verdicts}
+    # the assembly as mounted: the rack's pose raised (the sweep moves it from there)
+    spec = dataclasses.replace(run.assembly.part("rack"), pose=pose)
+    mounted = dataclasses.replace(run.assembly, parts=(run.assembly.part("pinion"), spec))
+    result = _sweep(run, mounted, moved, step_deg=2.0)
+    verdicts = {v.name: v.passed for v in result.verdicts}
     assert not verdicts["no_interference_anywhere"] and not result.passed
-    assert result.summary["verdict_pass"] == 0
+    assert _written(result)["verdict_pass"] == 0
     # in conjugate towing (well before the trimmed teeth) every pose overlaps by 2·δ·tan α
     expected = 2.0 * raise_mm * math.tan(math.radians(params.pinion.pressure_angle_deg))
     depth = np.array([-r["signed_clearance_mm"] for r in result.rows

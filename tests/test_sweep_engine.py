@@ -55,3 +55,37 @@ def test_bisection_refuses_a_pair_that_never_touches():
 
     with pytest.raises(ValueError, match="does not reach contact"):
         bisect_contact(collides, free=5.0, touching=4.0)
+
+
+def test_contact_proven_from_both_sides_on_a_known_gap():
+    from gearcheck.sweep.tools import prove_contact
+
+    scene = Scene([box("a", (2, 2, 2)), box("b", (1, 1, 1))])
+    pose = translation(2.0)  # b's near face at x = 1.5: gap 0.5 to a's face at x = 1
+    proof = prove_contact(scene, "a", "b", pose, np.array([-1.0, 0, 0]), 0.5, 0.02, "box", 1e-8)
+    assert proof.free_at_minus and proof.touching_at_plus and proof.holds(1e-6)
+    assert proof.contact_mm == pytest.approx(0.5, abs=1e-7)
+    wrong = prove_contact(scene, "a", "b", pose, np.array([-1.0, 0, 0]), 0.3, 0.02, "box", 1e-8)
+    assert not wrong.touching_at_plus and not wrong.holds(0.01)  # a clearance claimed too small is caught
+
+
+def test_clearing_and_contact_distances_and_events():
+    from gearcheck.sweep.tools import clearing_distance, contact_distance, extrapolated_event, smallest_clearing_move
+
+    scene = Scene([box("a", (2, 2, 2)), box("b", (1, 1, 1))])
+
+    def hits_from(x0):
+        def hits(d):
+            scene.set_pose("b", translation(x0 + d))
+            return scene.collide("a", "b")
+        return hits
+
+    assert clearing_distance(hits_from(1.4), 0.01, 5.0, 1e-8) == pytest.approx(0.1, abs=1e-7)
+    assert contact_distance(lambda d: hits_from(2.0)(-d), 0.01, 5.0, 1e-8) == pytest.approx(0.5, abs=1e-7)
+    assert smallest_clearing_move(hits_from(1.4), 1.0, 0.0, 1e-8) == pytest.approx(0.1, abs=1e-7)
+    assert smallest_clearing_move(lambda d: True, 1.0, 0.0, 1e-8) is None  # jammed: no jump past
+    # an event decided at an offset δ, linear in δ, extrapolated to δ = 0
+    grid = np.linspace(0.0, 1.0, 11)
+    x, bracket = extrapolated_event(grid, lambda d: grid >= 0.42 + 0.3 * d, lambda d, x: x >= 0.42 + 0.3 * d,
+                                    0.01, 1e-10, first=True)
+    assert x == pytest.approx(0.42, abs=1e-9) and bracket.free < 0.423 <= bracket.touching

@@ -1,4 +1,4 @@
-"""Track-drive sprocket (seed 002): the analytical model against the paper and against theory."""
+"""Track-drive sprocket: the analytical model against the paper and against theory."""
 
 import json
 import math
@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from gearcheck.cli import main
+from gearcheck.design import load_template
 from gearcheck.geometry import iso606
-from gearcheck.mechanisms import load_template
 from gearcheck.mechanisms.track import analysis, calc
 from gearcheck.params import ParamError
 
@@ -41,7 +41,7 @@ def test_paper_diameters(template):
     assert f["pitch_diameter_mm"] == pytest.approx(234.6, abs=0.1)
     assert f["root_diameter_mm"] == pytest.approx(226.6, abs=0.1)
     assert f["tip_diameter_mm"] == pytest.approx(235.0, abs=0.1)
-    # Groove chord: 15.031 (reference §2), not 15.000 (which would make the link chord 29.94).
+    # Groove chord: 15.031 (hand check), not 15.000 (which would make the link chord 29.94).
     assert f["groove_chord_mm"] == pytest.approx(15.031, abs=5e-4)
     # Two groove steps (2·asin(chord/d) at the centre) span exactly one chain pitch.
     d = f["pitch_diameter_mm"]
@@ -69,7 +69,7 @@ def test_diameters_follow_z_and_pitch(template, override, p, z):
 
 def test_iso606_limits(template):
     f = figures(template)
-    # Reference §2 at z = 49, dR = 8: ri 4.04–4.18, re 48.96–165.2, α 118.2°–138.2°.
+    # Hand check at z = 49, dR = 8: ri 4.04–4.18, re 48.96–165.2, α 118.2°–138.2°.
     assert f["iso_seating_radius_min_mm"] == pytest.approx(4.04, abs=1e-9)
     assert f["iso_seating_radius_max_mm"] == pytest.approx(4.178, abs=1e-9)  # 4.04 + 0.069·2
     assert f["iso_flank_radius_min_mm"] == pytest.approx(48.96, abs=1e-9)
@@ -127,7 +127,7 @@ def test_outline_repeats_every_groove(template):
 def test_tip_gap_reproduced(template, tip_gap):
     f = figures(template, f"track_plate.tip_gap_mm={tip_gap}")
     assert f["tip_gap_mm"] == pytest.approx(tip_gap, abs=0.01)
-    # Reference §2 hand check: the plate sits about gap + 1.07 mm outside the pin line.
+    # Hand check: the plate sits about gap + 1.07 mm outside the pin line.
     assert f["plate_offset_mm"] == pytest.approx(tip_gap + 1.07, abs=0.01)
     assert f["link_pin_line_radius_mm"] == pytest.approx(116.34, abs=0.01)
     assert f["tip_gap_ok"] == 1.0
@@ -228,6 +228,31 @@ def test_large_sleeve(template):
         load_template(template, best)
     assert info.value.field == "sprocket.tip_over_pitch_mm"
     assert figures(template, *best, "sprocket.tip_over_pitch_mm=0.1")["tip_land_width_mm"] > 0
+
+
+# --- the mechanism ---------------------------------------------------------------------------
+
+def test_mechanism_analyse_is_calc(template):
+    from gearcheck.mechanism import get
+
+    impl = get("track")
+    assert (impl.name, impl.section, impl.template, impl.mesh_tol_mm) == ("track", "track", TEMPLATE, 0.008)
+    params = load_template(template).params
+    assert [(f.key, f.value) for f in impl.analyse(params)] == [(f.key, f.value) for f in calc(params)]
+    assert impl.fuzz_options(params) == {} and impl.nan_figures == frozenset()
+
+
+def test_mechanism_sampler_redraws_the_template(template):
+    from gearcheck.mechanism import get
+    from gearcheck.mechanisms.sampling import RandomDraw
+    from gearcheck.params import read_toml
+
+    base = read_toml(template)
+    data = json.loads(json.dumps(base))
+    get("track").sample(data, RandomDraw(1))
+    assert data["mechanism"] == "track" and set(data) == set(base)
+    assert data["chain"]["pitch_mm"] != base["chain"]["pitch_mm"]
+    assert data["sprocket"]["teeth"] != base["sprocket"]["teeth"] or data["robot"] != base["robot"]
 
 
 # --- command line -----------------------------------------------------------------------------

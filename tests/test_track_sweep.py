@@ -1,6 +1,8 @@
-"""Track drive sweep (issue 10): tooth–sleeve clearance, seated tip gap and tip-to-plate distance
-over an engagement cycle, on the generated meshes (cad) and in the exact 2-D model (numpy)."""
+"""Track drive sweep: tooth–sleeve clearance, seated tip gap and tip-to-plate distance over an
+engagement cycle, on the generated meshes (cad) and in the exact 2-D model (numpy)."""
 
+import contextlib
+import json
 import math
 import subprocess
 import sys
@@ -8,10 +10,15 @@ import sys
 import numpy as np
 import pytest
 
+from gearcheck import pipeline
+from gearcheck.design import load_template
 from gearcheck.geometry import track_chain as tc
-from gearcheck.mechanisms import load_template
-from gearcheck.mechanisms.track import check
-from gearcheck.sweep.engine import Body, MeshData, Scene
+from gearcheck.geometry.track_section import ExactSection, plate_boundary
+from gearcheck.mechanism import get
+from gearcheck.mechanisms.track import sweep as track_sweep
+from gearcheck.report.files import summary_json
+from gearcheck.sweep.bodies import Body, MeshData
+from gearcheck.sweep.engine import Scene
 
 TEMPLATE = "eod_track_drive"
 # Reduced sampling for the tests: 24 steps per cycle (β/24 = 0.61°) still covers the cycle plus
@@ -21,12 +28,18 @@ TEST_STEPS = 24
 
 @pytest.fixture(scope="module")
 def model(templates_dir):
-    return check.track_model(load_template(templates_dir / f"{TEMPLATE}.toml").params)
+    """The layout the mechanism's assembly derives for its sweep."""
+    return get("track").assembly(load_template(templates_dir / f"{TEMPLATE}.toml").params).layout
 
 
 @pytest.fixture(scope="module")
 def exact(model):
-    return check.ExactSection(model)
+    return ExactSection(model.gap, model.link)
+
+
+def verdict_pass(result) -> int:
+    """summary.json's ``verdict_pass`` for a sweep result."""
+    return json.loads(summary_json(result))["track"]["verdict_pass"]
 
 
 def seated_link(model, angle=0.0):
@@ -75,7 +88,7 @@ def test_exact_model_repeats_after_one_cycle(model, exact):
 
 def test_plate_boundary_leaves_out_the_part_inside_the_sleeve(model):
     geo = model.link
-    segments = check.plate_boundary(geo)
+    segments = plate_boundary(geo)
     r, e = geo.sleeve_radius_mm, geo.plate_offset_mm
     for a, b in segments:
         for t in np.linspace(0, 1, 11):
@@ -87,15 +100,17 @@ def test_plate_boundary_leaves_out_the_part_inside_the_sleeve(model):
 
 def test_sweep_angles_cover_a_cycle_with_margins(model):
     beta = model.wrap.cycle_rad
-    angles = check.sweep_angles(model.wrap, 60, 0.125)
+    angles = track_sweep.sweep_angles(model.wrap, 60, 0.125)
     assert angles[0] < 0.0 and angles[-1] > beta
     assert np.isclose(angles, 0.0).any() and np.isclose(angles, beta).any()
     covered = (angles[-1] - angles[0]) / beta  # margins rounded up to whole steps
     assert 1.25 <= covered <= 1.25 + 2.0 / 60 + 1e-12
 
 
-def test_check_module_does_not_import_cadquery():
-    code = ("import sys, gearcheck.mechanisms.track.check; "
+def test_sweep_modules_do_not_import_cadquery():
+    code = ("import sys, gearcheck.mechanisms.track.mechanism, gearcheck.mechanisms.track.assembly, "
+            "gearcheck.mechanisms.track.sweep, gearcheck.mechanisms.track.verdicts, "
+            "gearcheck.mechanisms.track.report, gearcheck.geometry.track_section; "
             "sys.exit(any(m.split('.')[0] in ('cadquery', 'OCP') for m in sys.modules))")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
@@ -103,12 +118,31 @@ def test_check_module_does_not_import_cadquery():
 # --- the sweep on the generated meshes ----------------------------------------------------------
 
 
+def counting_progress(counted: list):
+    """A pipeline progress factory that records every update."""
+
+    class Bar:
+        def update(self, n: int = 1) -> None:
+            counted.append(n)
+
+    @contextlib.contextmanager
+    def progress(_desc, _total=None, _unit=""):
+        yield Bar()
+
+    return progress
+
+
+def sweep(run, jobs: int = 1, **options):
+    return pipeline.sweep(run.design, run.assembly, run.bodies, jobs=jobs, options=options)
+
+
 @pytest.fixture(scope="module")
 def template_run(build_bodies):
-    loaded, _, bodies = build_bodies(TEMPLATE)
+    run = build_bodies(TEMPLATE)
     counted = []
-    result = check.run_check(loaded.params, bodies, counted.append, steps_per_cycle=TEST_STEPS, workers=1)
-    return loaded, bodies, result, sum(counted)
+    result = pipeline.sweep(run.design, run.assembly, run.bodies, jobs=1, options={"steps_per_cycle": TEST_STEPS},
+                            progress=counting_progress(counted))
+    return run.design, run.bodies, result, sum(counted)
 
 
 @pytest.mark.cad
@@ -116,9 +150,9 @@ def test_template_sweep_verdicts_and_figures(template_run):
     loaded, bodies, result, progressed = template_run
     s = result.summary
     bound = s["mesh_error_bound_mm"]
-    assert result.passed and s["verdict_pass"] == 1, [v for v in result.verdicts if not v.passed]
-    assert {v.key for v in result.verdicts} >= {"no_interference", "seated_tip_gap_in_window",
-                                                 "min_tip_plate_distance"}
+    assert result.passed and verdict_pass(result) == 1, [v for v in result.verdicts if not v.passed]
+    assert {v.name for v in result.verdicts} >= {"no_interference", "seated_tip_gap_in_window",
+                                                  "min_tip_plate_distance", "contact_proven", "mesh_agrees_with_exact"}
     # coverage: at least one whole cycle, every pose counted by the progress callback
     assert s["cycles_covered"] >= 1.0
     assert s["poses"] == len(result.rows) == progressed
@@ -159,7 +193,7 @@ def test_worst_poses_are_the_reported_minima(template_run):
     """Re-measure the worst poses from their own data (poses as data, nothing else shared)."""
     loaded, bodies, result, _ = template_run
     link = next(b for n, b in bodies.items() if n.startswith("link_"))
-    _, plate = check.split_link_mesh(link.mesh, loaded.params.chain.sleeve_diameter_mm / 2.0)
+    _, plate = track_sweep.split_link_mesh(link.mesh, loaded.params.chain.sleeve_diameter_mm / 2.0)
     scene = Scene([bodies["sprocket"].mesh, plate, MeshData("whole", link.mesh.vertices, link.mesh.faces)])
     sleeve_pose, plate_pose = result.worst_poses
     assert sleeve_pose.part_b in bodies and plate_pose.part_b.endswith(".plate")
@@ -173,22 +207,28 @@ def test_worst_poses_are_the_reported_minima(template_run):
 
 
 @pytest.mark.cad
-def test_bodies_from_another_wrap_are_refused(template_run):
-    loaded, bodies, _, _ = template_run
-    moved = dict(bodies)
+def test_bodies_from_another_wrap_are_refused(build_bodies):
+    run = build_bodies(TEMPLATE)
+    moved = dict(run.bodies)
     name = "link_03"
-    b = bodies[name]
+    b = run.bodies[name]
     moved[name] = Body(b.mesh, b.pose @ tc.planar_matrix(0.0, 0.0, 0.01), b.error_bound_mm)
-    with pytest.raises(ValueError, match="wrap"):
-        check.run_check(loaded.params, moved, steps_per_cycle=2, workers=1)
+    with pytest.raises(ValueError, match="link_03: pose differs"):
+        pipeline.sweep(run.design, run.assembly, moved, jobs=1, options={"steps_per_cycle": 2})
+    # every link must be a copy of one mesh (the sweep moves one link mesh along the wrap)
+    other = dict(run.bodies)
+    other[name] = Body(run.bodies["sprocket"].mesh, b.pose, b.error_bound_mm)
+    with pytest.raises(ValueError, match="share one mesh"):
+        pipeline.sweep(run.design, run.assembly, other, jobs=1, options={"steps_per_cycle": 2})
+    with pytest.raises(ValueError, match="unknown options"):
+        pipeline.sweep(run.design, run.assembly, run.bodies, jobs=1, options={"steps": 2})
 
 
 @pytest.mark.cad
 def test_seated_gap_follows_the_template_gap(build_bodies):
     """--set track_plate.tip_gap_mm=0.5 moves the plate face: the measured seated gap follows, the
     contact bracket with it, and 0.5 mm is still inside the paper's window."""
-    loaded, _, bodies = build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.5",))
-    result = check.run_check(loaded.params, bodies, steps_per_cycle=12, workers=2)
+    result = sweep(build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.5",)), jobs=2, steps_per_cycle=12)
     s = result.summary
     bound = s["mesh_error_bound_mm"]
     assert s["seated_tip_gap_mm"] == pytest.approx(0.5, abs=bound)
@@ -201,10 +241,9 @@ def test_seated_gap_follows_the_template_gap(build_bodies):
 @pytest.mark.cad
 def test_a_gap_below_the_window_fails(build_bodies):
     """A plate 0.3 mm over the tips: measured as such, the window verdicts fail, the rest hold."""
-    loaded, _, bodies = build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.3",))
-    result = check.run_check(loaded.params, bodies, steps_per_cycle=4, workers=1)
-    verdicts = {v.key: v.passed for v in result.verdicts}
+    result = sweep(build_bodies(TEMPLATE, ("track_plate.tip_gap_mm=0.3",)), jobs=1, steps_per_cycle=4)
+    verdicts = {v.name: v.passed for v in result.verdicts}
     assert result.summary["seated_tip_gap_mm"] == pytest.approx(0.3, abs=result.summary["mesh_error_bound_mm"])
     assert not verdicts["seated_tip_gap_in_window"] and not verdicts["min_tip_plate_distance"]
     assert verdicts["no_interference"] and verdicts["contact_proven"] and not result.passed
-    assert result.summary["verdict_pass"] == 0
+    assert verdict_pass(result) == 0

@@ -69,7 +69,8 @@ def render_table(title: str, figures: list[Figure]) -> str:
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
     lines = [title, "=" * len(title)]
     for i, r in enumerate(rows):
-        cells = [r[0].ljust(widths[0])] + [r[k].rjust(widths[k]) if k != 2 else r[k].ljust(widths[k]) for k in range(1, 5)]
+        cells = [r[0].ljust(widths[0])] + [r[k].rjust(widths[k]) if k != 2 else r[k].ljust(widths[k])
+                                           for k in range(1, 5)]
         lines.append("  ".join(cells) + ("  " + r[5] if r[5] else ""))
         if i == 0:
             lines.append("  ".join("-" * w for w in widths) + "  ----")

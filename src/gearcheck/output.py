@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from pathlib import Path
@@ -25,7 +26,8 @@ def ensure_out_dir(folder: Path) -> Path:
     try:
         fd, probe = tempfile.mkstemp(prefix=".gearcheck-write-test.", suffix=".part", dir=folder)
     except OSError as exc:
-        raise ParamError("--out", str(folder), f"folder is not writable (cannot create a file there: {exc.strerror})") from None
+        raise ParamError("--out", str(folder),
+                         f"folder is not writable (cannot create a file there: {exc.strerror})") from None
     os.close(fd)
     os.unlink(probe)
     return folder
@@ -57,10 +59,8 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
             os.fsync(fh.fileno())
         os.replace(tmp, path)
     except BaseException:
-        try:
+        with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)
-        except FileNotFoundError:
-            pass
         raise
 
 

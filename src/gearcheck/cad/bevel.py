@@ -93,7 +93,7 @@ def conical_loft(profile: SectionProfile, z_other: float) -> cq.Solid:
     """Solid between the planes of ``profile`` and z_other bounded by the cone (through the
     apex) over the outline: ruled loft to the outline scaled by z_other / z_plane."""
     wire = profile_wire(profile)
-    other = wire.scale(z_other / profile.z_plane)  # homothety about the apex
+    other = cq.Wire(wire.scale(z_other / profile.z_plane).wrapped)  # homothety about the apex
     return cq.Solid.makeLoft([other, wire] if z_other < profile.z_plane else [wire, other],
                              ruled=True)
 

@@ -15,7 +15,7 @@ from OCP.gp import gp_Pnt
 from OCP.TopoDS import TopoDS_Compound
 
 from gearcheck.cad.placement import Part, place
-from gearcheck.sweep.result import WorstPose
+from gearcheck.results import WorstPose
 
 
 def _posed(parts: dict[str, Part], name: str, pose, scale: float):

@@ -55,11 +55,17 @@ def sha256(path: Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
 
-def write_step(parts: list[Part], path: Path, assembly_name: str) -> None:
-    """STEP assembly with one named, coloured component per part (mm), written atomically."""
+def cad_assembly(parts: list[Part], assembly_name: str) -> cq.Assembly:
+    """A named, coloured CadQuery assembly: one component per part at its pose (mm)."""
     assy = cq.Assembly(name=assembly_name)
     for part in parts:
         assy.add(part.solid, name=part.name, loc=location(part.pose), color=cq.Color(*part.color))
+    return assy
+
+
+def write_step(parts: list[Part], path: Path, assembly_name: str) -> None:
+    """STEP assembly with one named, coloured component per part (mm), written atomically."""
+    assy = cad_assembly(parts, assembly_name)
     tmp = temp_path_beside(path)
     try:
         assy.export(str(tmp), exportType="STEP", unit="MM")
@@ -125,7 +131,7 @@ def export_parts(
                 "watertight": e.mesh.is_watertight(),
                 "winding_consistent": e.mesh.is_winding_consistent(),
                 "pose": np.asarray(e.part.pose).tolist(),
-                "motion": e.part.motion,
+                "motion": e.part.motion.to_dict() if e.part.motion is not None else {},
                 "stl": {"file": e.stl.name, "sha256": sha256(e.stl)},
             }
             for e in exported
@@ -136,16 +142,3 @@ def export_parts(
         manifest.update(extra)
     atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
     return manifest, exported
-
-
-def sweep_bodies(exported: list[ExportedPart]) -> dict:
-    """The exported parts as the sweep layer's :class:`~gearcheck.sweep.engine.Body` objects
-    (plain arrays: picklable, no CAD kernel needed to use them)."""
-    from gearcheck.sweep.engine import Body, MeshData
-
-    return {
-        e.part.name: Body(MeshData(e.part.name, e.mesh.vertices, e.mesh.faces), np.asarray(e.part.pose, float),
-                          e.mesh.error_bound_mm, e.part.material, dict(e.part.motion))
-        for e in exported
-    }
-

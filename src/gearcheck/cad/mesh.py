@@ -1,7 +1,7 @@
 """B-rep → watertight triangle mesh with an ABSOLUTE chordal tolerance (numpy out).
 
 CadQuery's exporters treat the tolerance as relative or default to 0.1 mm — the size of the
-backlash we measure (reference.md, "Measured facts"). Here: BRepTools.Clean, then
+backlash we measure. Here: BRepTools.Clean, then
 BRepMesh_IncrementalMesh(shape, tol_mm, relative=False, angular, parallel), read every face's
 triangulation (its location applied, winding flipped on reversed faces) and merge the
 per-face copies of shared edge nodes into one vertex each.
@@ -103,7 +103,11 @@ def mesh_shape(shape, tol_mm: float = CHORDAL_TOL_MM, angular_rad: float = ANGUL
     params.EnableControlSurfaceDeflectionAllSurfaces = True
     BRepMesh_IncrementalMesh(topo, params)
 
-    verts, uvs, tris, owner, faces = [], [], [], [], []
+    verts: list[np.ndarray] = []
+    uvs: list[np.ndarray] = []
+    tris: list[np.ndarray] = []
+    owner: list[np.ndarray] = []
+    faces: list = []
     offset = 0
     for face in _faces_of(topo):
         loc = TopLoc_Location()

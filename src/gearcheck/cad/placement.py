@@ -7,6 +7,7 @@ Poses are numpy matrices, so the sweep can move meshes with the same transforms 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import cadquery as cq
 import numpy as np
@@ -39,8 +40,9 @@ class Part:
     solid: cq.Shape
     pose: np.ndarray = field(default_factory=lambda: np.eye(4))
     color: tuple[float, float, float] = (0.7, 0.7, 0.75)
-    # how the sweep may move it, e.g. {"kind": "rotation", "axis": [...], "origin": [...]}
-    motion: dict = field(default_factory=dict)
+    # how the sweep may move it (a gearcheck.sweep.motion Rotation / Translation / ChainLink;
+    # cad/ only records it: ``motion.to_dict()`` in the manifest)
+    motion: Any = None
     # named sub-solids in the same frame (a link's "plate" and "sleeve"), so a check can confirm
     # a distance to one feature ("link_03.plate") on the exact B-rep
     features: dict = field(default_factory=dict)

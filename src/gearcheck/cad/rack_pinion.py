@@ -1,4 +1,4 @@
-"""Nose-wheel steering pinion sector and trimmed rack as B-rep solids (seed 003), from numpy data.
+"""Nose-wheel steering pinion sector and trimmed rack as B-rep solids, from numpy data.
 
 Both parts are planar outlines extruded along z (mid-plane z = 0), so each solid is exact where
 its profile is exact:
@@ -7,20 +7,21 @@ its profile is exact:
   tooth j centred at γ = (j + ½)·τ): per sector tooth, B-spline trochoid fillets and involute
   flanks interpolating exact points (:func:`gearcheck.geometry.rack_pinion.pinion_tooth_pieces`),
   a tip arc (radius Ra, or RS1 on G1 and its mirror); root-circle arcs between teeth and round
-  the back; the bore as the inner wire. Pose at pinion angle φ: turn by φ about z, move to (0, H).
+  the back; the bore as the inner wire. Pose at pinion angle φ
+  (:func:`gearcheck.geometry.rack_pinion.pinion_pose`): turn by φ about z, move to (0, H).
 - Rack (its own frame is the world frame at travel 0: datum face y = 0, tooth k centred at
   x = k·p): the polygon of :meth:`RackPinionGeometry.rack_outline` — straight flanks, the trimmed
   tops S2–S6 / S4–S8 as straight lines between their corners, sharp roots, the bar down to the
-  datum. Pose at travel L: move by L along x.
+  datum. Pose at travel L (:func:`gearcheck.geometry.rack_pinion.rack_pose`): move by L along x.
 
-The paper gives neither face width, bore nor materials: they are named constants here.
+The paper gives neither face width nor bore: they come in as arguments (a mechanism's part specs,
+:class:`gearcheck.geometry.rack_pinion.PinionSpec` / ``RackSpec``). Poses, materials and motions
+are the mechanism's (its assembly); this module builds solids only.
 """
 
 from __future__ import annotations
 
 import math
-import time
-from dataclasses import dataclass, field
 
 import cadquery as cq
 import numpy as np
@@ -28,11 +29,7 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeWire
 from OCP.BRepCheck import BRepCheck_Analyzer
 
 from gearcheck.geometry import rack_pinion as rp
-from gearcheck.geometry.rack_pinion import RackPinionGeometry
-from gearcheck.cad.placement import Part
-# Face width and pinion bore (not in the paper) live with the mechanism, whose template model
-# checks that the bore fits before any CAD work; re-exported here.
-from gearcheck.mechanisms.steering.layout import FACE_WIDTH_MM, PINION_BORE_DIAMETER_MM, bore_fits
+from gearcheck.geometry.rack_pinion import RackPinionGeometry, bore_fits
 
 # Exact points interpolated per involute flank (uniform in roll angle). Measured on the built
 # solid against the closed-form involute (docs/rack_pinion_cad.md): 8 → 0.047 µm, 12 → 0.008 µm,
@@ -41,9 +38,6 @@ FLANK_SPLINE_POINTS = 24
 # Exact trochoid points per fillet (not a contact surface; the fillet meets the involute at the
 # form circle, where both share the point and, in theory, the tangent).
 FILLET_SPLINE_POINTS = 24
-# Materials (not in the paper; aircraft steering gears are through-hardened alloy steel).
-PINION_MATERIAL = "steel"
-RACK_MATERIAL = "steel"
 
 
 def _v(p: np.ndarray, z: float) -> cq.Vector:
@@ -91,25 +85,16 @@ def pinion_outline_wire(g: RackPinionGeometry, z: float = 0.0, flank_points: int
     return _wire(edges, "pinion")
 
 
-def build_pinion(g: RackPinionGeometry, face_width_mm: float = FACE_WIDTH_MM,
-                 bore_diameter_mm: float = PINION_BORE_DIAMETER_MM,
+def build_pinion(g: RackPinionGeometry, face_width_mm: float, bore_diameter_mm: float,
                  flank_points: int = FLANK_SPLINE_POINTS) -> cq.Solid:
-    """The pinion solid in its own frame, z from −b/2 to b/2."""
+    """The pinion solid in its own frame, z from −b/2 to b/2 (b = ``face_width_mm``), with a
+    bore of ``bore_diameter_mm`` (inside the root circle)."""
     if not bore_fits(g.root_radius, bore_diameter_mm):
         raise ValueError("pinion bore reaches the root circle")
     z0 = -face_width_mm / 2.0
     outer = pinion_outline_wire(g, z0, flank_points)
     bore = cq.Wire.makeCircle(bore_diameter_mm / 2.0, cq.Vector(0, 0, z0), cq.Vector(0, 0, 1))
     return cq.Solid.extrudeLinear(outer, [bore], cq.Vector(0, 0, face_width_mm))
-
-
-def pinion_pose(g: RackPinionGeometry, phi: float) -> np.ndarray:
-    """Pinion frame → world at pinion angle φ (counter-clockwise about z, centre at (0, H, 0))."""
-    c, s = math.cos(phi), math.sin(phi)
-    pose = np.eye(4)
-    pose[:2, :2] = [[c, -s], [s, c]]
-    pose[1, 3] = g.centre_to_datum_mm
-    return pose
 
 
 # ------------------------------------------------------------------------------------ rack
@@ -120,50 +105,7 @@ def rack_outline_wire(g: RackPinionGeometry, z: float = 0.0) -> cq.Wire:
     return cq.Wire.makePolygon(pts, close=True)
 
 
-def build_rack(g: RackPinionGeometry, face_width_mm: float = FACE_WIDTH_MM) -> cq.Solid:
+def build_rack(g: RackPinionGeometry, face_width_mm: float) -> cq.Solid:
     """The rack solid in its own frame, z from −b/2 to b/2; its bottom face is the datum y = 0."""
     z0 = -face_width_mm / 2.0
     return cq.Solid.extrudeLinear(rack_outline_wire(g, z0), [], cq.Vector(0, 0, face_width_mm))
-
-
-def rack_pose(travel_mm: float) -> np.ndarray:
-    """Rack frame → world at travel L (along +x)."""
-    pose = np.eye(4)
-    pose[0, 3] = travel_mm
-    return pose
-
-
-# ----------------------------------------------------------------------------------- parts
-
-@dataclass(frozen=True)
-class SteeringParts:
-    """Pinion and rack at one pose, and what built them."""
-
-    geometry: RackPinionGeometry
-    pinion: Part
-    rack: Part
-    build_s: dict[str, float] = field(default_factory=dict)
-
-    @property
-    def parts(self) -> list[Part]:
-        return [self.pinion, self.rack]
-
-
-def steering_parts(params, pinion_angle_rad: float = 0.0, rack_travel_mm: float = 0.0,
-                   face_width_mm: float = FACE_WIDTH_MM) -> SteeringParts:
-    """Pinion and rack for the steering template's ``Params``. The default pose is angle 0
-    (φ = 0, L = 0): pinion centre at (0, H, 0), rack tooth k = 0 centred under it, tight mesh."""
-    from gearcheck.mechanisms.steering import analysis  # owns the template → geometry mapping
-
-    g = analysis.geometry_from_params(params)
-    t0 = time.perf_counter()
-    pinion = build_pinion(g, face_width_mm)
-    t1 = time.perf_counter()
-    rack = build_rack(g, face_width_mm)
-    t2 = time.perf_counter()
-    return SteeringParts(
-        geometry=g,
-        pinion=Part("pinion", PINION_MATERIAL, pinion, pinion_pose(g, pinion_angle_rad), motion={"kind": "rotation", "axis": [0.0, 0.0, 1.0], "origin": [0.0, float(g.centre_to_datum_mm), 0.0]}),
-        rack=Part("rack", RACK_MATERIAL, rack, rack_pose(rack_travel_mm), motion={"kind": "translation", "axis": [1.0, 0.0, 0.0]}),
-        build_s={"pinion": t1 - t0, "rack": t2 - t1},
-    )

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -79,7 +79,7 @@ class BevelGearSpec:
     def __post_init__(self):
         if self.teeth < 5 or self.mate_teeth < 5:
             raise ValueError("teeth and mate_teeth must be >= 5")
-        if not (0 < self.module_mm and 0 < self.face_width_mm):
+        if not (self.module_mm > 0 and self.face_width_mm > 0):
             raise ValueError("module_mm and face_width_mm must be > 0")
         if not (10.0 <= self.pressure_angle_deg <= 30.0):
             raise ValueError("pressure_angle_deg must be in [10, 30]")
@@ -255,8 +255,8 @@ class BevelGearSpec:
 
 def mating_spec(spec: BevelGearSpec, **changes) -> BevelGearSpec:
     """The other gear of the pair: teeth swapped, profile shift negated, default blank."""
-    base = dict(teeth=spec.mate_teeth, mate_teeth=spec.teeth, profile_shift=-spec.profile_shift,
-                mounting_distance_mm=None, front_face_distance_mm=None, bore_mm=0.0)
+    base: dict[str, Any] = dict(teeth=spec.mate_teeth, mate_teeth=spec.teeth, profile_shift=-spec.profile_shift,
+                                mounting_distance_mm=None, front_face_distance_mm=None, bore_mm=0.0)
     base.update(changes)
     return replace(spec, **base)
 
@@ -278,7 +278,7 @@ def roll_angle_at_polar(base_angle: float, polar) -> np.ndarray:
     return _rolled_arc(base_angle, np.asarray(polar, dtype=float)) / math.sin(base_angle)
 
 
-def _rolled_arc(base_angle: float, polar: np.ndarray) -> np.ndarray:
+def _rolled_arc(base_angle: float, polar: np.ndarray | np.floating) -> np.ndarray:
     """s with cos s = cos θ / cos δb, in the form tan s = √(sin(θ−δb)·sin(θ+δb)) / cos θ, which
     keeps full precision at the base cone (arccos of a ratio near 1 loses half the digits)."""
     prod = np.sin(polar - base_angle) * np.sin(polar + base_angle)
@@ -611,7 +611,7 @@ def analytic_volume_mm3(spec: BevelGearSpec, nodes: int = 400) -> float:
     cuts = sorted({spec.root_angle_rad, spec.face_angle_rad,
                    min(max(spec.base_angle_rad, spec.root_angle_rad), spec.face_angle_rad)})
     x, w = np.polynomial.legendre.leggauss(nodes)
-    for lo, hi in zip(cuts[:-1], cuts[1:]):
+    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
         th = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
         width = 2 * flank_azimuth(spec, th, +1)
         f = width * (re**3 - ri**3) / (3 * np.cos(th - d) ** 3) * np.sin(th)

@@ -101,7 +101,7 @@ class PlacedGear:
     pose: np.ndarray
     scale: float = 1.0
 
-    def turned(self, angle: float) -> "PlacedGear":
+    def turned(self, angle: float) -> PlacedGear:
         return PlacedGear(self.spec, self.pose @ rot_z4(angle), self.scale)
 
 
@@ -298,7 +298,7 @@ def _first_contact(sets: list[_FlankSet], direction: int) -> Contact:
             # a separate local extreme: another tooth, or two cells away on the same tooth
             if any(i == idx[0] and abs(j - idx[1]) <= 2 and abs(m - idx[2]) <= 2 for i, j, m in picked):
                 continue
-            picked.append(tuple(int(x) for x in idx))
+            picked.append((int(idx[0]), int(idx[1]), int(idx[2])))
         cands = [(float(fs.teeth[i]), float(t[j]), float(u[m])) for i, j, m in picked]
         if not cands:
             continue

@@ -1,8 +1,8 @@
 """ISO 606 (GB/T 1243) roller-chain sprocket tooth form, numpy only.
 
-The track sprocket of seed 002 engages every other tooth: it has ``z`` teeth and ``z`` grooves,
-groove ``k`` centred on polar angle ``k·360°/z``, and a chain link (pitch ``p``) spans two groove
-pitches, so its pins sit in grooves two apart. Hence (paper eq. 6)
+The bomb-disposal robot's track sprocket engages every other tooth: it has ``z`` teeth and ``z``
+grooves, groove ``k`` centred on polar angle ``k·360°/z``, and a chain link (pitch ``p``) spans
+two groove pitches, so its pins sit in grooves two apart. Hence (paper eq. 6)
 
     d = p / sin(360°/z)          (standard sprocket: p / sin(180°/z))
 

@@ -1,4 +1,4 @@
-"""Exact 2D geometry of the trimmed rack and the topped pinion sector (seed 003), numpy only.
+"""Exact 2D geometry of the trimmed rack and the topped pinion sector, numpy only.
 
 Frame (millimetres, radians unless a name says ``_deg``):
 
@@ -157,7 +157,8 @@ class RackPinionGeometry:
     def rack_half_width(self, y):
         """Half width of a standard rack tooth at height y (straight flanks at α)."""
         a = self.pressure_angle_rad
-        return self.rack_half_thickness_at_rolling_line - (np.asarray(y, dtype=float) - self.rolling_line_height) * math.tan(a)
+        return (self.rack_half_thickness_at_rolling_line
+                - (np.asarray(y, dtype=float) - self.rolling_line_height) * math.tan(a))
 
     # --- pinion ---------------------------------------------------------------------------
     def involute_half_angle(self, rho):
@@ -395,3 +396,49 @@ def involute_flank_distance(g: RackPinionGeometry, rho, gamma_rel, side: int) ->
     angles differ by δ, so the distance is rb·(γ − side·β(ρ))·side, exact for every ρ ≥ rb."""
     beta = g.involute_half_angle(rho)
     return side * g.base_radius * (np.asarray(gamma_rel, dtype=float) - side * beta)
+
+
+# --- parts as data (what gearcheck.cad.rack_pinion builds from) and their poses ---------------
+
+def bore_fits(root_radius_mm: float, bore_diameter_mm: float) -> bool:
+    """The pinion bore lies strictly inside the root circle (a ring of material is left)."""
+    return bore_diameter_mm / 2.0 < root_radius_mm
+
+
+@dataclass(frozen=True)
+class PinionSpec:
+    """The pinion solid as data: the drawing, the face width b (extruded from −b/2 to b/2) and
+    the bore, which must lie inside the root circle."""
+
+    geometry: RackPinionGeometry
+    face_width_mm: float
+    bore_diameter_mm: float
+
+    def __post_init__(self) -> None:
+        if not bore_fits(self.geometry.root_radius, self.bore_diameter_mm):
+            raise ValueError(f"pinion bore Ø{self.bore_diameter_mm:g} mm reaches the root circle "
+                             f"(radius {self.geometry.root_radius:g} mm)")
+
+
+@dataclass(frozen=True)
+class RackSpec:
+    """The rack solid as data: the drawing and the face width b (extruded from −b/2 to b/2)."""
+
+    geometry: RackPinionGeometry
+    face_width_mm: float
+
+
+def pinion_pose(g: RackPinionGeometry, phi: float) -> np.ndarray:
+    """Pinion frame → world at pinion angle φ (counter-clockwise about z, centre at (0, H, 0))."""
+    c, s = math.cos(phi), math.sin(phi)
+    pose = np.eye(4)
+    pose[:2, :2] = [[c, -s], [s, c]]
+    pose[1, 3] = g.centre_to_datum_mm
+    return pose
+
+
+def rack_pose(travel_mm: float) -> np.ndarray:
+    """Rack frame → world at travel L (along +x); the identity at travel 0."""
+    pose = np.eye(4)
+    pose[0, 3] = travel_mm
+    return pose

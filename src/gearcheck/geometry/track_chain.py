@@ -1,4 +1,4 @@
-"""Track chain wrapped on the every-other-tooth sprocket (seed 002): link poses as data, numpy only.
+"""Track chain wrapped on the every-other-tooth sprocket: link poses as data, numpy only.
 
 Frames (millimetres, radians):
 
@@ -97,7 +97,7 @@ class ChainWrap:
 
     @classmethod
     def centred(cls, teeth: int, pitch_mm: float, links: int | None = None, entry_angle_deg: float = 90.0,
-                wrap_angle_deg: float = 120.0, run_links: int = 2) -> "ChainWrap":
+                wrap_angle_deg: float = 120.0, run_links: int = 2) -> ChainWrap:
         """The segment whose middle pin sits, at θ = 0, in the groove nearest the middle of the wrap
         (so both runs carry about the same number of links). Without ``links``: as many links as
         the wrap seats (wrap/β, rounded) plus ``run_links`` on each run."""

@@ -18,6 +18,8 @@ from typing import Any
 import annotated_types as at
 from pydantic import BaseModel, ConfigDict, ValidationError
 
+from gearcheck.geometry.bisect import bisect
+
 # Guard against pathological files before any parsing work.
 MAX_TEMPLATE_BYTES = 1_000_000
 # Deepest nesting a template may have (a template is sections of keys, a key may hold a flat
@@ -52,7 +54,7 @@ class ParamError(Exception):
             return f"{where}{_one_line(self.field)} = {_show(self.value)}: {_one_line(self.allowed)}"
         return f"{where}{_one_line(self.allowed)}"
 
-    def with_source(self, source: str) -> "ParamError":
+    def with_source(self, source: str) -> ParamError:
         return ParamError(self.field, self.value, self.allowed, source)
 
 
@@ -62,10 +64,7 @@ def bisect_boundary(ok, good: float, bad: float, steps: int) -> float | None:
     say how far a rejected value may go."""
     if not ok(good):
         return None
-    for _ in range(steps):
-        mid = 0.5 * (good + bad)
-        good, bad = (mid, bad) if ok(mid) else (good, mid)
-    return good
+    return bisect(lambda x: not ok(x), good, bad, tol=None, max_iter=steps, check_ends=False).free
 
 
 def _one_line(text: str) -> str:
@@ -102,7 +101,8 @@ def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:
         current = info.annotation
     if info is None:
         return ""
-    lo = hi = None
+    lo: Any = None
+    hi: Any = None
     lo_open = hi_open = False
     for meta in info.metadata:
         if isinstance(meta, at.Ge):
@@ -154,21 +154,24 @@ def _first_error(model: type[BaseModel], exc: ValidationError, data: dict) -> Pa
         return ParamError(path, value, f"unknown key (allowed keys here: {known})")
     if kind == "missing":
         return ParamError(path, MISSING, "required key is missing")
+    return ParamError(path, value, _value_problem(model, loc, kind, value, err["msg"]))
+
+
+def _value_problem(model: type[BaseModel], loc: tuple[str, ...], kind: str, value: Any, msg: str) -> str:
+    """What is wrong with a present value, with the field's allowed range where it has one."""
     allowed = field_range(model, loc)
     if isinstance(value, int) and not isinstance(value, bool) and abs(value) > 2 ** 1023:
         # a TOML integer beyond any float: pydantic calls it the wrong type
-        return ParamError(path, value, f"out of range (larger than any float): {allowed}" if allowed
-                          else "out of range (larger than any float)")
+        return f"out of range (larger than any float): {allowed}" if allowed else "out of range (larger than any float)"
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
-        return ParamError(path, value, f"out of range: {allowed}")
+        return f"out of range: {allowed}"
     if kind == "finite_number":
-        return ParamError(path, value, f"must be a finite number ({allowed})" if allowed else "must be a finite number")
-    if kind.endswith("_type") or kind.endswith("_parsing"):
-        detail = err["msg"].lower()
+        return f"must be a finite number ({allowed})" if allowed else "must be a finite number"
+    if kind.endswith(("_type", "_parsing")):
         wanted = _field_type(model, loc)
         extra = f"; {allowed}" if allowed else (f"; allowed type: {wanted}" if wanted else "")
-        return ParamError(path, value, f"wrong type: {detail}{extra}")
-    return ParamError(path, value, err["msg"] + (f" ({allowed})" if allowed else ""))
+        return f"wrong type: {msg.lower()}{extra}"
+    return msg + (f" ({allowed})" if allowed else "")
 
 
 def validate(model: type[BaseModel], data: dict, source: str = "") -> BaseModel:
@@ -207,20 +210,39 @@ def parse_override(text: str) -> tuple[tuple[str, ...], Any]:
     return path, value
 
 
+def _set_path(node: dict, path: tuple[str, ...], value: Any) -> None:
+    for name in path[:-1]:
+        child = node.get(name)
+        if not isinstance(child, dict):
+            # Let validation name the unknown section with its allowed keys.
+            child = {}
+            node[name] = child
+        node = child
+    node[path[-1]] = value
+
+
 def apply_overrides(data: dict, overrides: list[str]) -> dict:
     """Return a copy of ``data`` with each ``--set`` override applied (type checks come later)."""
     out = copy.deepcopy(data)
     for text in overrides:
         path, value = parse_override(text)
-        node = out
-        for name in path[:-1]:
-            child = node.get(name)
-            if not isinstance(child, dict):
-                # Let validation name the unknown section with its allowed keys.
-                child = {}
-                node[name] = child
-            node = child
-        node[path[-1]] = value
+        _set_path(out, path, value)
+    return out
+
+
+def apply_values(data: dict, values: dict[str, Any]) -> dict:
+    """Return a copy of ``data`` with ``{"section.key": value}`` applied (Python values, as the
+    API takes them; a string is taken as it is). Type and range checks come later, as for
+    ``--set``."""
+    out = copy.deepcopy(data)
+    for key, value in values.items():
+        path = tuple(p.strip() for p in str(key).split("."))
+        if not key or any(not p for p in path):
+            raise ParamError("overrides", key, "expected a key 'section.key'")
+        if len(path) > MAX_NESTING:
+            raise ParamError("overrides", key, f"key nested {len(path)} levels deep; allowed at most {MAX_NESTING}")
+        _check_nesting(value, str(key), len(path))
+        _set_path(out, path, copy.deepcopy(value))
     return out
 
 

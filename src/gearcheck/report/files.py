@@ -7,7 +7,7 @@ import io
 import json
 import math
 
-from gearcheck.sweep.result import CheckResult
+from gearcheck.results import CheckResult
 
 
 def _plain(value):
@@ -25,14 +25,14 @@ def _plain(value):
     return value
 
 
-def summary_json(result: CheckResult, confirmations: dict | None = None) -> str:
-    """``{section: {...summary..., "verdicts": {key: 1/0}, "verdict_pass": 1/0,
-    "exact_confirmation": {label: {...}}}}`` with sorted keys."""
+def summary_json(result: CheckResult) -> str:
+    """``{section: {...summary..., "verdicts": {name: 1/0}, "verdict_pass": 1/0,
+    "exact_confirmation": {key: {mesh_mm, brep_mm, bound_mm}}}}`` with sorted keys."""
     body = dict(result.summary)
-    body["verdicts"] = {v.key: int(v.passed) for v in result.verdicts}
+    body["verdicts"] = {v.name: int(v.passed) for v in result.verdicts}
     body["verdict_pass"] = int(result.passed)
-    if confirmations:
-        body["exact_confirmation"] = confirmations
+    if result.confirmations:
+        body["exact_confirmation"] = {c.key: c.figures() for c in result.confirmations}
     return json.dumps({result.section: _plain(body)}, indent=2, sort_keys=True, allow_nan=False) + "\n"
 
 

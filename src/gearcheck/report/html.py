@@ -11,7 +11,7 @@ import io
 import math
 
 from gearcheck import __version__
-from gearcheck.sweep.result import CheckResult, Plot
+from gearcheck.results import CheckResult, Plot
 
 CSS = """
 body { font-family: -apple-system, 'Segoe UI', Helvetica, Arial, sans-serif; margin: 2em auto;
@@ -33,7 +33,7 @@ td.ok { color: #17612a; font-weight: 600; } td.bad { color: #8a1c1c; font-weight
 def _fmt(x, digits: int = 4) -> str:
     if x is None:
         return ""
-    if isinstance(x, bool) or isinstance(x, int):
+    if isinstance(x, (bool, int)):
         return str(int(x))
     if isinstance(x, float):
         if not math.isfinite(x):
@@ -90,7 +90,7 @@ def plot_svg(plot: Plot) -> str:
                     bbox={"boxstyle": "round,pad=0.15", "fc": "white", "ec": "0.45", "lw": 0.6})
     # Horizontal reference lines go into the legend (labels at the axis edge collide).
     hlines = [(label, y) for label, y in plot.hlines if y is not None and math.isfinite(y)]
-    for (label, y), colour in zip(hlines, HLINE_COLOURS * (1 + len(hlines) // len(HLINE_COLOURS))):
+    for (label, y), colour in zip(hlines, HLINE_COLOURS * (1 + len(hlines) // len(HLINE_COLOURS)), strict=False):
         shown = label if any(c.isdigit() for c in label) else f"{label} ({y:.4g})"  # the value once
         ax.axhline(y, ls=":", lw=1.3, color=colour, label=shown)
     ax.set_title(plot.title, fontsize=11)
@@ -107,9 +107,8 @@ def plot_svg(plot: Plot) -> str:
     return text[text.index("<svg"):]
 
 
-def render(result: CheckResult, *, title: str, template: str, build: dict, confirmations: dict) -> str:
-    """The whole page. ``build``: manifest figures (tolerance, triangles, version);
-    ``confirmations``: {label: {"mesh_mm", "brep_mm", "bound_mm", "parts"}}."""
+def render(result: CheckResult, *, title: str, template: str, build: dict) -> str:
+    """The whole page. ``build``: manifest figures (tolerance, triangles, version)."""
     ok = result.passed
     parts = [f"<!doctype html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
              f"<style>{CSS}</style></head><body>"]
@@ -122,13 +121,15 @@ def render(result: CheckResult, *, title: str, template: str, build: dict, confi
 
     parts.append("<h2>Verdicts</h2><table><tr><th>claim</th><th>result</th><th>measured</th></tr>")
     for v in result.verdicts:
+        word = {"pass": "pass", "warn": "warn", "fail": "FAIL"}[v.level]
         parts.append(f"<tr><td>{html.escape(v.label)}</td><td class='{'ok' if v.passed else 'bad'}'>"
-                     f"{'pass' if v.passed else 'FAIL'}</td><td>{html.escape(v.detail)}</td></tr>")
+                     f"{word}</td><td>{html.escape(v.measured)}</td></tr>")
     parts.append("</table>")
 
     if result.comparisons:
         parts.append("<h2>Paper, model, geometry</h2><table><tr><th>figure</th><th>unit</th><th>paper</th>"
-                     "<th>analytical model</th><th>exact model</th><th>geometry (mesh sweep)</th><th>why they differ</th></tr>")
+                     "<th>analytical model</th><th>exact model</th><th>geometry (mesh sweep)</th>"
+                     "<th>why they differ</th></tr>")
         for c in result.comparisons:
             parts.append(f"<tr><td>{html.escape(c.label)}</td><td>{html.escape(c.unit)}</td>"
                          f"<td class='num'>{_fmt(c.paper)}</td><td class='num'>{_fmt(c.model)}</td>"
@@ -136,17 +137,17 @@ def render(result: CheckResult, *, title: str, template: str, build: dict, confi
                          f"<td>{html.escape(c.note)}</td></tr>")
         parts.append("</table>")
 
-    if confirmations:
+    if result.confirmations:
         parts.append("<h2>Worst poses confirmed on the exact B-rep</h2><p>Mesh distances overstate "
                      "clearance by up to the mesh-error bound (chords lie inside convex flanks); each "
                      "sweep's worst pose is re-measured on the B-rep solids (OCC BRepExtrema).</p>"
                      "<table><tr><th>pose</th><th>parts</th><th>mesh distance mm</th><th>B-rep distance mm</th>"
                      "<th>difference mm</th><th>mesh-error bound mm</th></tr>")
-        for label, c in confirmations.items():
-            diff = c["mesh_mm"] - c["brep_mm"]
-            parts.append(f"<tr><td>{html.escape(label)}</td><td>{html.escape(c['parts'])}</td>"
-                         f"<td class='num'>{c['mesh_mm']:.5f}</td><td class='num'>{c['brep_mm']:.5f}</td>"
-                         f"<td class='num'>{diff:+.5f}</td><td class='num'>{c['bound_mm']:.4f}</td></tr>")
+        for k in result.confirmations:
+            diff = k.mesh_mm - k.brep_mm
+            parts.append(f"<tr><td>{html.escape(k.label)}</td><td>{html.escape(k.parts)}</td>"
+                         f"<td class='num'>{k.mesh_mm:.5f}</td><td class='num'>{k.brep_mm:.5f}</td>"
+                         f"<td class='num'>{diff:+.5f}</td><td class='num'>{k.bound_mm:.4f}</td></tr>")
         parts.append("</table>")
 
     if result.plots:

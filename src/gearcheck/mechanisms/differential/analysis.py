@@ -404,3 +404,48 @@ def analyse(*, module_mm: float, big_teeth: int, small_teeth: int, pressure_angl
         unshimmed_warm_total_min_arcmin=2.0 * big_gear_arcmin(mesh_thinning_min_mm, geom),
         unshimmed_warm_total_max_arcmin=2.0 * big_gear_arcmin(mesh_thinning_max_mm, geom),
     )
+
+
+def analyse_params(params, *, cold_C: float | None = None) -> DifferentialResult:
+    """Run the model on a validated template (optionally at another cold temperature)."""
+    g, d, m = params.gears, params.dimensions, params.materials
+    return analyse(
+        module_mm=g.module_mm, big_teeth=g.big_teeth, small_teeth=g.small_teeth,
+        pressure_angle_deg=g.pressure_angle_deg, small_profile_shift=g.small_profile_shift,
+        mesh_thinning_min_mm=params.backlash.mesh_thinning_min_mm,
+        mesh_thinning_max_mm=params.backlash.mesh_thinning_max_mm,
+        a_mm=d.a_mm, b_mm=d.b_mm, l11_mm=d.l11_mm, l12_mm=d.l12_mm, l2_mm=d.l2_mm,
+        housing_cte_per_K=m.housing_cte_per_K, shaft_cte_per_K=m.shaft_cte_per_K,
+        gear_cte_per_K=m.gear_cte_per_K,
+        warm_C=params.operating.warm_C,
+        cold_C=params.operating.cold_C if cold_C is None else cold_C,
+        shim_mm=params.shim.thickness_mm, shim_study_mm=params.shim.study_mm,
+    )
+
+
+@dataclass(frozen=True)
+class PerSide:
+    """The paper's model per side (one big/small mesh), arcmin, at one shim and the built
+    thinning (the template's least): warm and cold play in the printed and the clean form of
+    eq (9), and the cold drops."""
+
+    warm: float
+    cold: float
+    clean_warm: float
+    clean_cold: float
+    drop: float
+    clean_drop: float
+
+
+def model_per_side(params, shim_mm: float) -> PerSide:
+    """Paper's model (eqs 1–11) per side, at the built thinning (the template's least)."""
+    r = analyse_params(params)
+    geom = r.geometry
+    alpha = math.radians(params.gears.pressure_angle_deg)
+    gain = shim_gain(geom, alpha, shim_mm)
+    thinning = big_gear_arcmin(params.backlash.mesh_thinning_min_mm, geom)
+    warm = thinning + gain.per_side_arcmin
+    clean_warm = thinning + gain.clean_per_side_arcmin
+    return PerSide(warm=warm, cold=warm - r.cold.per_side_arcmin, clean_warm=clean_warm,
+                   clean_cold=clean_warm - r.cold.clean_per_side_arcmin, drop=r.cold.per_side_arcmin,
+                   clean_drop=r.cold.clean_per_side_arcmin)

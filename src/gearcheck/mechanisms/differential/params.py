@@ -34,11 +34,16 @@ class Gears(Section):
     """Two big and two small straight bevel gears, 90° shafts, long/short addendum."""
 
     module_mm: float = Field(ge=0.5, le=10.0, description="outer (transverse) module m", json_schema_extra=_unit("mm"))
-    big_teeth: int = Field(ge=10, le=200, description="teeth of each big (output) gear, z1", json_schema_extra=_unit("teeth"))
-    small_teeth: int = Field(ge=6, le=200, description="teeth of each small (cross-axis) gear, z2", json_schema_extra=_unit("teeth"))
-    face_width_mm: float = Field(gt=0.0, le=100.0, description="face width along the pitch element", json_schema_extra=_unit("mm"))
-    pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="normal pressure angle α", json_schema_extra=_unit("deg"))
-    shaft_angle_deg: float = Field(description="angle between big and small gear axes; the model needs 90", json_schema_extra=_unit("deg"))
+    big_teeth: int = Field(ge=10, le=200, description="teeth of each big (output) gear, z1",
+                           json_schema_extra=_unit("teeth"))
+    small_teeth: int = Field(ge=6, le=200, description="teeth of each small (cross-axis) gear, z2",
+                             json_schema_extra=_unit("teeth"))
+    face_width_mm: float = Field(gt=0.0, le=100.0, description="face width along the pitch element",
+                                 json_schema_extra=_unit("mm"))
+    pressure_angle_deg: float = Field(ge=14.5, le=30.0, description="normal pressure angle α",
+                                      json_schema_extra=_unit("deg"))
+    shaft_angle_deg: float = Field(description="angle between big and small gear axes; the model needs 90",
+                                   json_schema_extra=_unit("deg"))
     small_profile_shift: float = Field(
         ge=-1.0, le=1.5,
         description="profile shift coefficient x of the small gear (the big gear gets −x: long/short addendum)",
@@ -46,7 +51,7 @@ class Gears(Section):
     )
 
     @model_validator(mode="after")
-    def _rules(self) -> "Gears":
+    def _rules(self) -> Gears:
         if self.shaft_angle_deg != 90.0:
             raise ParamError("gears.shaft_angle_deg", self.shaft_angle_deg,
                              "allowed 90 deg only: eqs (1), (6), (7) assume perpendicular big and small gear axes")
@@ -65,7 +70,8 @@ class Gears(Section):
         x_max = analysis.max_small_shift_for_tip(geom, alpha)
         x_min = max(mesh.small_undercut_min_shift, analysis.min_small_shift_for_interference(geom, alpha))
         shift_range = (f"allowed {x_min:.3f} to {x_max:.3f}" if x_min <= x_max else
-                       f"no shift allowed at {self.small_teeth}/{self.big_teeth} teeth and {self.pressure_angle_deg:g}° "
+                       f"no shift allowed at {self.small_teeth}/{self.big_teeth} teeth and "
+                       f"{self.pressure_angle_deg:g}° "
                        f"(no undercut needs >= {x_min:.3f}, a 0.25·m tip land <= {x_max:.3f})")
         if x < mesh.small_undercut_min_shift:
             raise ParamError("gears.small_profile_shift", x,
@@ -75,7 +81,8 @@ class Gears(Section):
         if mesh.big_tip_path_mm > mesh.big_tip_path_limit_mm:
             raise ParamError("gears.small_profile_shift", x,
                              f"{shift_range}: the big gear's tip runs inside the small gear's base circle "
-                             f"(tip interference on the back-cone virtual pair); Gleason's rule gives {mesh.gleason_small_shift:.2f}")
+                             f"(tip interference on the back-cone virtual pair); Gleason's rule gives "
+                             f"{mesh.gleason_small_shift:.2f}")
         min_tip = analysis.MIN_TIP_THICKNESS_MODULES * self.module_mm
         if mesh.small_tip_thickness_mm < min_tip:
             raise ParamError("gears.small_profile_shift", x,
@@ -88,7 +95,8 @@ class Gears(Section):
             bound = f"allowed >= {x_low:.3f}" if x_low is not None else "no shift allowed up to the small gear's limit"
             raise ParamError("gears.small_profile_shift", x,
                              f"{bound}: pointed teeth, the big gear's tip (shift −x) is "
-                             f"{mesh.big_tip_thickness_mm:.3f} mm thick on the back cone, less than 0.25·m = {min_tip:.3f} mm")
+                             f"{mesh.big_tip_thickness_mm:.3f} mm thick on the back cone, less than 0.25·m = "
+                             f"{min_tip:.3f} mm")
         if mesh.contact_ratio < analysis.MIN_CONTACT_RATIO:
             raise ParamError("gears.small_profile_shift", x,
                              f"contact ratio of the back-cone virtual pair is {mesh.contact_ratio:.3f}, allowed >= "
@@ -112,7 +120,7 @@ class Backlash(Section):
     )
 
     @model_validator(mode="after")
-    def _band(self) -> "Backlash":
+    def _band(self) -> Backlash:
         if self.mesh_thinning_max_mm < self.mesh_thinning_min_mm:
             raise ParamError("backlash.mesh_thinning_max_mm", self.mesh_thinning_max_mm,
                              f"allowed >= mesh_thinning_min_mm = {self.mesh_thinning_min_mm} mm")
@@ -138,25 +146,37 @@ class Materials(Section):
 class Dimensions(Section):
     """Housing and gear mounting lengths of eqs (2)–(7) (the paper's Table 2 is lost: reconstructed)."""
 
-    a_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the small gears' mounting faces", json_schema_extra=_unit("mm"))
-    b_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the big gears' mounting faces", json_schema_extra=_unit("mm"))
-    l11_mm: float = Field(ge=0.0, le=500.0, description="big gear shaft (Ti) length, mounting face to gear joint", json_schema_extra=_unit("mm"))
-    l12_mm: float = Field(ge=0.0, le=500.0, description="big gear body (steel), shaft joint to outer pitch circle plane", json_schema_extra=_unit("mm"))
-    l2_mm: float = Field(ge=0.0, le=500.0, description="small gear, mounting face to outer pitch circle plane", json_schema_extra=_unit("mm"))
+    a_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the small gears' mounting faces",
+                        json_schema_extra=_unit("mm"))
+    b_mm: float = Field(gt=0.0, le=1000.0, description="housing: between the big gears' mounting faces",
+                        json_schema_extra=_unit("mm"))
+    l11_mm: float = Field(ge=0.0, le=500.0, description="big gear shaft (Ti) length, mounting face to gear joint",
+                          json_schema_extra=_unit("mm"))
+    l12_mm: float = Field(ge=0.0, le=500.0,
+                          description="big gear body (steel), shaft joint to outer pitch circle plane",
+                          json_schema_extra=_unit("mm"))
+    l2_mm: float = Field(ge=0.0, le=500.0, description="small gear, mounting face to outer pitch circle plane",
+                         json_schema_extra=_unit("mm"))
 
 
 class Operating(Section):
     """Temperatures: warm_C is where the backlash is set and measured (room temperature)."""
 
-    warm_C: float = Field(ge=-60, le=150, description="assembly / room temperature where thinning and shim set the backlash", json_schema_extra=_unit("°C"))
+    warm_C: float = Field(ge=-60, le=150,
+                          description="assembly / room temperature where thinning and shim set the backlash",
+                          json_schema_extra=_unit("°C"))
     cold_C: float = Field(ge=-150, le=25, description="cold design point", json_schema_extra=_unit("°C"))
-    operating_min_C: float = Field(ge=-150, le=150, description="lowest operating temperature", json_schema_extra=_unit("°C"))
-    operating_max_C: float = Field(ge=-150, le=150, description="highest operating temperature", json_schema_extra=_unit("°C"))
-    storage_min_C: float = Field(ge=-150, le=150, description="lowest storage temperature", json_schema_extra=_unit("°C"))
-    storage_max_C: float = Field(ge=-150, le=150, description="highest storage temperature", json_schema_extra=_unit("°C"))
+    operating_min_C: float = Field(ge=-150, le=150, description="lowest operating temperature",
+                                   json_schema_extra=_unit("°C"))
+    operating_max_C: float = Field(ge=-150, le=150, description="highest operating temperature",
+                                   json_schema_extra=_unit("°C"))
+    storage_min_C: float = Field(ge=-150, le=150, description="lowest storage temperature",
+                                 json_schema_extra=_unit("°C"))
+    storage_max_C: float = Field(ge=-150, le=150, description="highest storage temperature",
+                                 json_schema_extra=_unit("°C"))
 
     @model_validator(mode="after")
-    def _order(self) -> "Operating":
+    def _order(self) -> Operating:
         if self.cold_C > self.warm_C:
             raise ParamError("operating.cold_C", self.cold_C, f"allowed <= warm_C = {self.warm_C} °C")
         if self.operating_min_C > self.operating_max_C:
@@ -178,14 +198,15 @@ def shim_key(shim_mm: float) -> str:
 class Shim(Section):
     """Adjusting shim under each big gear; it moves the gear away from the mesh (eq 11)."""
 
-    thickness_mm: float = Field(ge=0.0, le=1.0, description="shim under each big gear in this design", json_schema_extra=_unit("mm"))
+    thickness_mm: float = Field(ge=0.0, le=1.0, description="shim under each big gear in this design",
+                                json_schema_extra=_unit("mm"))
     study_mm: list[float] = Field(
         default_factory=list, max_length=MAX_STUDY_SHIMS,
         description="shims to tabulate (the paper's test: 0, 0.05, 0.10, 0.15)", json_schema_extra=_unit("mm"),
     )
 
     @model_validator(mode="after")
-    def _study(self) -> "Shim":
+    def _study(self) -> Shim:
         seen: dict[str, float] = {}
         for i, s in enumerate(self.study_mm):
             if not (0.0 <= s <= 1.0) or not math.isfinite(s):
@@ -209,7 +230,7 @@ class Params(Section):
     shim: Shim
 
     @model_validator(mode="after")
-    def _assembly(self) -> "Params":
+    def _assembly(self) -> Params:
         geom = analysis.cone_geometry(self.gears.module_mm, self.gears.big_teeth, self.gears.small_teeth)
         d = self.dimensions
         b_apex = 2.0 * (d.l11_mm + d.l12_mm + geom.small_pitch_diameter_mm / 2.0)
@@ -241,7 +262,7 @@ class Params(Section):
 # work; the blame goes to the input that moves the failing check, with its allowed range found
 # by bisection on that same check.
 
-def _cad_blocker(params: "Params") -> str | None:
+def _cad_blocker(params: Params) -> str | None:
     """Why the CAD could not make these gears (BevelGearSpec's message), or None."""
     try:
         specs = poses.gear_specs(params)
@@ -251,7 +272,7 @@ def _cad_blocker(params: "Params") -> str | None:
     return None
 
 
-def _with(params: "Params", section: str, **values) -> "Params":
+def _with(params: Params, section: str, **values) -> Params:
     """A copy with some fields of one section replaced (not validated: for probing the specs)."""
     return params.model_copy(update={section: getattr(params, section).model_copy(update=values)})
 
@@ -260,13 +281,13 @@ def _boundary(ok, good: float, bad: float) -> float | None:
     return bisect_boundary(ok, good, bad, steps=50)
 
 
-def _blame(params: "Params", why: str) -> ParamError:
+def _blame(params: Params, why: str) -> ParamError:
     g, d = params.gears, params.dimensions
     geom = analysis.cone_geometry(g.module_mm, g.big_teeth, g.small_teeth)
 
     def cured(section: str, **values) -> bool:
         blocker = _cad_blocker(_with(params, section, **values))
-        return blocker is None or blocker.split(":")[0] != why.split(":")[0]
+        return blocker is None or blocker.split(":")[0] != why.split(":", maxsplit=1)[0]
 
     if "mounting_distance" in why:  # a back (mounting) face in front of its gear's outer root
         # Probe one gear at a time, the other's face moved far back (both messages read alike).
@@ -287,7 +308,8 @@ def _blame(params: "Params", why: str) -> ParamError:
         m = _boundary(lambda v: cured("gears", module_mm=v), 10.0, g.module_mm)
         bound = f"allowed >= {m:.3f} mm at these tooth counts" if m is not None else "no module up to 10 mm allowed"
         return ParamError("gears.module_mm", g.module_mm,
-                          f"{bound}: the gear bores ({poses.BIG_GEAR_BORE_MM:g} mm big, {poses.SMALL_GEAR_BORE_MM:g} mm "
+                          f"{bound}: the gear bores ({poses.BIG_GEAR_BORE_MM:g} mm big, "
+                          f"{poses.SMALL_GEAR_BORE_MM:g} mm "
                           "small) must lie under the roots at the inner end of the teeth")
     if "face cone" in why:
         z1 = next((n for n in range(g.big_teeth - 1, g.small_teeth - 1, -1) if cured("gears", big_teeth=n)), None)

@@ -11,7 +11,7 @@ and the assembly condition (z_big + z_big) / 2 integer, checked in :func:`assemb
 makes it mesh with the second small gear too.
 
 The shim moves each big gear (and its shaft) out along its own axis by the shim thickness: its
-apex leaves the common apex by x, which is what opens the backlash (seed 000 §2.2, ΔS1 = x).
+apex leaves the common apex by x, which is what opens the backlash (the paper's shim section, ΔS1 = x).
 """
 
 from __future__ import annotations
@@ -62,7 +62,7 @@ def gear_specs(params) -> GearSpecs:
         face_width_mm=g.face_width_mm, pressure_angle_deg=g.pressure_angle_deg,
         shaft_angle_deg=g.shaft_angle_deg, profile_shift=g.small_profile_shift,
         thinning_mm=thinning, bore_mm=SMALL_GEAR_BORE_MM,
-        # small gear: mounting face a/2 from the apex (seed 000 fig. 3: l2 behind the pitch circle)
+        # small gear: mounting face a/2 from the apex (the paper's mounting drawing: l2 behind the pitch circle)
         mounting_distance_mm=d.a_mm / 2.0,
     )
     big = BevelGearSpec(

@@ -1,8 +1,8 @@
 """Geometric thermal state of the differential: each gear moved and shrunk by its own materials.
 
-Numpy only. Reference §1 "Geometric thermal state": a uniform scale of the whole assembly changes
-no angle and proves nothing, so the cold state is built part by part along the chain that holds
-each gear (seed 000 fig. 3, eqs (2)–(7)):
+Numpy only. A uniform scale of the whole assembly changes no angle and proves nothing, so the
+cold state is built part by part along the chain that holds each gear (the paper's mounting
+drawing, eqs (2)–(7)):
 
 - the housing (aluminium, ξ1) shrinks about its centre, the common apex, so each mounting face
   on a gear axis moves by ξ1·(distance from the centre)·(T_cold − T_warm) along that axis;
@@ -15,7 +15,7 @@ each gear (seed 000 fig. 3, eqs (2)–(7)):
 - each gear body (steel, ξ3) then scales by f = 1 + ξ3·(T_cold − T_warm) about its datum.
 
 Output per gear: a world translation of the datum along the gear's axis (``pose_change``, 4×4)
-and a scale factor about ``datum_local`` (for :meth:`gearcheck.sweep.engine.Body.scaled`).
+and a scale factor about ``datum_local`` (for :meth:`gearcheck.sweep.bodies.Body.scaled`).
 
 Relation to eqs (6)/(7). Scaling about the datum moves the apex toward the datum by
 (1 − f)·z_j, so the apex moves along the axis, outward +, by

@@ -1,4 +1,4 @@
-"""Template model of the nose-wheel steering rack and pinion (seed 003).
+"""Template model of the nose-wheel steering rack and pinion.
 
 Only inputs: the pinion and rack basic profiles, the sector and rack tooth indices, the centre
 height H, the machined trims (hS2…hS8, RS1), the contact-ratio design rule and the two angle
@@ -13,6 +13,7 @@ set the CAD could not build is rejected before any CAD work.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from pydantic import Field, model_validator
 
@@ -20,8 +21,8 @@ from gearcheck.mechanisms.steering import analysis, layout
 from gearcheck.params import ParamError, Section
 from gearcheck.params.common import bisect_boundary
 
-MM = {"unit": "mm"}
-DEG = {"unit": "deg"}
+MM: dict[str, Any] = {"unit": "mm"}
+DEG: dict[str, Any] = {"unit": "deg"}
 # A tooth whose top land is thinner than this (in modules) is taken as pointed (as for the
 # differential's bevel gears); applies to the pinion tip and the rack tooth top.
 MIN_TOP_LAND_MODULES = 0.25
@@ -30,42 +31,61 @@ TEETH_MAX = 400  # most pinion teeth (field range)
 
 
 class Pinion(Section):
-    module_mm: float = Field(gt=0, le=50, description="Module m (paper: 4; see docs/steering.md for why not 5)", json_schema_extra=MM)
+    module_mm: float = Field(gt=0, le=50,
+        description="Module m (paper: 4; see docs/steering.md for why not 5)", json_schema_extra=MM)
     teeth: int = Field(ge=10, le=TEETH_MAX, description="Tooth count z of the full pinion (the sector is part of it)")
     profile_shift: float = Field(ge=-1.0, le=1.0, description="Profile shift coefficient x")
     pressure_angle_deg: float = Field(ge=10.0, le=35.0, description="Pressure angle α", json_schema_extra=DEG)
-    addendum_coefficient: float = Field(ge=ADDENDUM_MIN, le=1.5, description="Addendum ha* (tip radius r + (ha* + x)·m)")
-    dedendum_coefficient: float = Field(ge=0.5, le=2.0, description="Dedendum hf* = addendum of the generating rack cutter (sharp tip)")
-    sector_first_tooth: int = Field(ge=-200, le=0, description="Index j of G1, the first sector tooth, topped to RS1 (angle-0 convention: tooth j centred at (j + 1/2)·360°/z)")
-    sector_last_tooth: int = Field(ge=0, le=200, description="Index j of the last sector tooth (G1's mirror), topped to RS1")
-    topped_radius_mm: float = Field(gt=0, le=5000, description="RS1: tip radius of the two topped end teeth, as machined", json_schema_extra=MM)
+    addendum_coefficient: float = Field(ge=ADDENDUM_MIN, le=1.5,
+        description="Addendum ha* (tip radius r + (ha* + x)·m)")
+    dedendum_coefficient: float = Field(ge=0.5, le=2.0,
+        description="Dedendum hf* = addendum of the generating rack cutter (sharp tip)")
+    sector_first_tooth: int = Field(ge=-200, le=0,
+        description="Index j of G1, the first sector tooth, topped to RS1 (angle-0 convention: tooth j centred at "
+                    "(j + 1/2)·360°/z)")
+    sector_last_tooth: int = Field(ge=0, le=200,
+        description="Index j of the last sector tooth (G1's mirror), topped to RS1")
+    topped_radius_mm: float = Field(gt=0, le=5000,
+        description="RS1: tip radius of the two topped end teeth, as machined", json_schema_extra=MM)
 
 
 class Rack(Section):
-    first_tooth: int = Field(ge=-200, le=-2, description="Index k of the first rack tooth (trimmed at S2/S6); tooth k is centred at k·p at angle 0")
+    first_tooth: int = Field(ge=-200, le=-2,
+        description="Index k of the first rack tooth (trimmed at S2/S6); tooth k is centred at k·p at angle 0")
     last_tooth: int = Field(ge=2, le=200, description="Index k of the last rack tooth (mirror trims)")
-    addendum_coefficient: float = Field(ge=0.5, le=1.5, description="Rack addendum above its reference line, in modules")
-    dedendum_coefficient: float = Field(ge=0.5, le=2.0, description="Rack dedendum below its reference line, in modules")
+    addendum_coefficient: float = Field(ge=0.5, le=1.5,
+        description="Rack addendum above its reference line, in modules")
+    dedendum_coefficient: float = Field(ge=0.5, le=2.0,
+        description="Rack dedendum below its reference line, in modules")
 
 
 class Layout(Section):
-    centre_to_datum_mm: float = Field(gt=0, le=10000, description="H: pinion centre to the rack datum (mounting face)", json_schema_extra=MM)
+    centre_to_datum_mm: float = Field(gt=0, le=10000,
+        description="H: pinion centre to the rack datum (mounting face)", json_schema_extra=MM)
 
 
 class Trim(Section):
-    min_contact_ratio: float = Field(ge=1.0, le=3.0, description="Design rule that sets hS4 (paper: 1.2); solved, never checked against the machined heights")
-    hS2_mm: float = Field(gt=0, le=10000, description="Height of S2 above the datum (first rack tooth, drive-side top corner), as machined", json_schema_extra=MM)
-    hS4_mm: float = Field(gt=0, le=10000, description="Height of S4 (second rack tooth, drive-side top corner), as machined", json_schema_extra=MM)
-    hS6_mm: float = Field(gt=0, le=10000, description="Height of S6 (first rack tooth, other top corner), as machined", json_schema_extra=MM)
-    hS8_mm: float = Field(gt=0, le=10000, description="Height of S8 (second rack tooth, other top corner), as machined", json_schema_extra=MM)
+    min_contact_ratio: float = Field(ge=1.0, le=3.0,
+        description="Design rule that sets hS4 (paper: 1.2); solved, never checked against the machined heights")
+    hS2_mm: float = Field(gt=0, le=10000,
+        description="Height of S2 above the datum (first rack tooth, drive-side top corner), as machined",
+        json_schema_extra=MM)
+    hS4_mm: float = Field(gt=0, le=10000,
+        description="Height of S4 (second rack tooth, drive-side top corner), as machined", json_schema_extra=MM)
+    hS6_mm: float = Field(gt=0, le=10000,
+        description="Height of S6 (first rack tooth, other top corner), as machined", json_schema_extra=MM)
+    hS8_mm: float = Field(gt=0, le=10000,
+        description="Height of S8 (second rack tooth, other top corner), as machined", json_schema_extra=MM)
 
 
 class Targets(Section):
-    continuous_angle_deg: float = Field(gt=0, lt=180, description="Power-steering requirement: continuous drive to at least this pinion angle", json_schema_extra=DEG)
+    continuous_angle_deg: float = Field(gt=0, lt=180,
+        description="Power-steering requirement: continuous drive to at least this pinion angle", json_schema_extra=DEG)
 
 
 class Towing(Section):
-    max_angle_deg: float = Field(gt=0, le=180, description="Towing swing of the pinion (either way)", json_schema_extra=DEG)
+    max_angle_deg: float = Field(gt=0, le=180,
+        description="Towing swing of the pinion (either way)", json_schema_extra=DEG)
 
 
 class Params(Section):
@@ -77,12 +97,31 @@ class Params(Section):
     towing: Towing
 
     @model_validator(mode="after")
-    def _physical(self) -> "Params":
+    def _physical(self) -> Params:
         _check(self)
         return self
 
 
+def _check_indexing(p: Params) -> None:
+    """Tooth indexing: G1 sits left of the first rack tooth and drives it (paper fig. 5)."""
+    pin, rack, z = p.pinion, p.rack, p.pinion.teeth
+    if rack.last_tooth != -rack.first_tooth:
+        raise ParamError("rack.last_tooth", rack.last_tooth,
+                         f"must mirror rack.first_tooth: allowed {-rack.first_tooth} (the trims repeat at both ends)")
+    if pin.sector_first_tooth != rack.first_tooth - 1:
+        raise ParamError("pinion.sector_first_tooth", pin.sector_first_tooth,
+                         f"allowed {rack.first_tooth - 1} = rack.first_tooth - 1 "
+                         "(the topped tooth G1 drives the first rack tooth)")
+    if pin.sector_last_tooth != rack.last_tooth:
+        raise ParamError("pinion.sector_last_tooth", pin.sector_last_tooth,
+                         f"allowed {rack.last_tooth} = rack.last_tooth (mirror of G1)")
+    sector = pin.sector_last_tooth - pin.sector_first_tooth + 1
+    if sector > z:
+        raise ParamError("pinion.teeth", z, f"allowed >= {sector} (the {sector}-tooth sector is part of the pinion)")
+
+
 def _check(p: Params) -> None:
+    _check_indexing(p)
     pin, rack, trim = p.pinion, p.rack, p.trim
     m, z, x = pin.module_mm, pin.teeth, pin.profile_shift
     a = math.radians(pin.pressure_angle_deg)
@@ -91,37 +130,28 @@ def _check(p: Params) -> None:
     tip = r + (pin.addendum_coefficient + x) * m
     H = p.layout.centre_to_datum_mm
 
-    # Tooth indexing: G1 sits left of the first rack tooth and drives it (paper fig. 5).
-    if rack.last_tooth != -rack.first_tooth:
-        raise ParamError("rack.last_tooth", rack.last_tooth, f"must mirror rack.first_tooth: allowed {-rack.first_tooth} (the trims repeat at both ends)")
-    if pin.sector_first_tooth != rack.first_tooth - 1:
-        raise ParamError("pinion.sector_first_tooth", pin.sector_first_tooth,
-                         f"allowed {rack.first_tooth - 1} = rack.first_tooth - 1 (the topped tooth G1 drives the first rack tooth)")
-    if pin.sector_last_tooth != rack.last_tooth:
-        raise ParamError("pinion.sector_last_tooth", pin.sector_last_tooth,
-                         f"allowed {rack.last_tooth} = rack.last_tooth (mirror of G1)")
-    sector = pin.sector_last_tooth - pin.sector_first_tooth + 1
-    if sector > z:
-        raise ParamError("pinion.teeth", z, f"allowed >= {sector} (the {sector}-tooth sector is part of the pinion)")
-
     # Basic profiles: clearances, no undercut, no pointed teeth.
     # (The shift moves the rack's reference line with the pinion, so it cancels in both.)
     if rack.dedendum_coefficient <= pin.addendum_coefficient:
         raise ParamError("rack.dedendum_coefficient", rack.dedendum_coefficient,
-                         f"allowed > {pin.addendum_coefficient:g} (pinion addendum: the pinion tip must clear the rack root)")
+                         f"allowed > {pin.addendum_coefficient:g} "
+                         "(pinion addendum: the pinion tip must clear the rack root)")
     if pin.dedendum_coefficient <= rack.addendum_coefficient:
         raise ParamError("pinion.dedendum_coefficient", pin.dedendum_coefficient,
-                         f"allowed > {rack.addendum_coefficient:g} (rack addendum: the rack tip must clear the pinion root)")
+                         f"allowed > {rack.addendum_coefficient:g} "
+                         "(rack addendum: the rack tip must clear the pinion root)")
     depth = (pin.dedendum_coefficient - x) * m
     if depth > r * math.sin(a) ** 2:
         z_min = 2.0 * (pin.dedendum_coefficient - x) / math.sin(a) ** 2
-        raise ParamError("pinion.teeth", z, f"undercut by the generating rack at this shift and dedendum: allowed >= {math.ceil(z_min)}")
+        raise ParamError("pinion.teeth", z,
+                         f"undercut by the generating rack at this shift and dedendum: allowed >= {math.ceil(z_min)}")
     g = analysis.geometry_from_params(p)
     _check_tooth_forms(g)
     rack_root = H - r - x * m - rack.dedendum_coefficient * m
     if rack_root <= 0:
         raise ParamError("layout.centre_to_datum_mm", H,
-                         f"allowed > {r + x * m + rack.dedendum_coefficient * m:g} mm (the rack root must lie above its datum)")
+                         f"allowed > {r + x * m + rack.dedendum_coefficient * m:g} mm "
+                         "(the rack root must lie above its datum)")
 
     # Trims: between the rolling line and the rack tooth top; hS4 must keep the contact ratio >= 1.
     h = H - r
@@ -142,7 +172,8 @@ def _check(p: Params) -> None:
     for name in ("hS2_mm", "hS4_mm", "hS6_mm", "hS8_mm"):
         value = getattr(trim, name)
         lo = max(h, h_for_ratio(1.0)) if name == "hS4_mm" else h
-        why = "contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm" else "above the rack pitch line, at most the rack tooth top"
+        why = ("contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm"
+               else "above the rack pitch line, at most the rack tooth top")
         if not (lo < value <= top):
             raise ParamError(f"trim.{name}", value, f"allowed >{lo:.3f} to {top:.3f} mm ({why})")
     if trim.min_contact_ratio > eps_top:
@@ -155,7 +186,8 @@ def _check(p: Params) -> None:
     rs1_lo = max(H - trim.hS2_mm, _form_radius(r, rb, a, depth))
     if not (rs1_lo < rs1 <= tip):
         raise ParamError("pinion.topped_radius_mm", rs1,
-                         f"allowed >{rs1_lo:.3f} to {tip:.3f} mm (G1's tip circle must reach S2 at height hS2; at most the tip radius)")
+                         f"allowed >{rs1_lo:.3f} to {tip:.3f} mm "
+                         "(G1's tip circle must reach S2 at height hS2; at most the tip radius)")
     _check_trim_clearance(g)
 
 
@@ -177,7 +209,8 @@ def _check_tooth_forms(g) -> None:
             raise ParamError("pinion.profile_shift", x,
                              f"allowed <= {x_max:.3f}: pointed pinion teeth, tip land "
                              f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
-        ha_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v)) >= land_min,
+        ha_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v))
+                           >= land_min,
                            lo, g.pinion_addendum_coefficient)
         raise ParamError("pinion.addendum_coefficient", g.pinion_addendum_coefficient,
                          f"allowed <= {ha_max:.3f} at this shift: pointed pinion teeth, tip land "
@@ -197,11 +230,13 @@ def _check_tooth_forms(g) -> None:
                          f"allowed < {(g.pitch / 2.0 - w0) / (m * tan_a) - x:.3f}: adjacent rack teeth would "
                          "meet above the rack root line (no tooth space left)")
     if not layout.bore_fits(g.root_radius):
-        z_min = next((n for n in range(g.teeth + 1, TEETH_MAX + 1) if layout.bore_fits(analysis.with_inputs(g, teeth=n).root_radius)), None)
+        z_min = next((n for n in range(g.teeth + 1, TEETH_MAX + 1)
+                      if layout.bore_fits(analysis.with_inputs(g, teeth=n).root_radius)), None)
         if z_min is None:
             m_min = _boundary(lambda v: layout.bore_fits(analysis.with_inputs(g, module_mm=v).root_radius), 50.0, m)
             raise ParamError("pinion.module_mm", m,
-                             f"allowed >= {m_min:.3f} mm at z = {g.teeth}: the root circle (radius {g.root_radius:.2f} mm) "
+                             f"allowed >= {m_min:.3f} mm at z = {g.teeth}: the root circle "
+                             f"(radius {g.root_radius:.2f} mm) "
                              f"must clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
         raise ParamError("pinion.teeth", g.teeth,
                          f"allowed >= {z_min} at m = {m:g} mm: the root circle (radius {g.root_radius:.2f} mm) must "

@@ -1,8 +1,9 @@
-"""Track-drive sprocket of a bomb-disposal robot (seed 002): ISO 606 groove form, every other
-tooth engaging, short tooth under the track plate; drive force, pin shear and crush stress.
+"""Track-drive sprocket of a bomb-disposal robot: ISO 606 groove form, every other tooth engaging,
+short tooth under the track plate; drive force, pin shear and crush stress.
 
 ``calc(params)`` returns the figures beside the paper's printed values (``PAPER``); the model and
-its readings are in :mod:`.analysis` and docs/track.md.
+its readings are in :mod:`.analysis` and docs/track.md. The mechanism itself (assembly, CAD hook,
+sweep, verdicts, report) is :class:`.mechanism.TrackDrive`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ from gearcheck.geometry import iso606
 from gearcheck.mechanisms.track import analysis
 from gearcheck.mechanisms.track.params import Params
 
-SECTION = "track"
 # Meshing tolerance when --tol is not given: the mesh-error bound must stay within 1/10 of the
 # least clearance checked (template: tooth–sleeve 0.100 mm, so ≤ 0.010 mm; 20 % margin).
 MESH_TOL_MM = 0.008
@@ -36,16 +36,27 @@ def _verdict(ok: bool) -> tuple[float, str]:
     return (1.0 if ok else 0.0), ("pass" if ok else "FAIL")
 
 
+class _Figures(list):
+    """The figures in table order; ``add`` attaches the paper's value where it has one."""
+
+    def add(self, key, label, value, unit, note="", digits=3):
+        self.append(Figure(key, label, float(value), unit, PAPER.get(key), note, digits))
+
+
 def calc(params: Params) -> list[Figure]:
-    r, gr, ch, sp, tp, mat, st = (params.robot, params.ground, params.chain, params.sprocket,
-                                  params.track_plate, params.materials, params.strength)
+    F = _Figures()
+    d, gap, lim = _geometry(params, F.add)
+    _plate(params, F.add, gap)
+    drive, design = _loads(params, F.add, d)
+    _pin(params, F.add, drive)
+    _crush(params, F.add, design, lim)
+    return list(F)
+
+
+def _geometry(params: Params, add):
+    """Eqs. 6-8: pitch, root and tip diameters; the ISO 606 form and its limits."""
+    ch, sp = params.chain, params.sprocket
     z, p, dr = sp.teeth, ch.pitch_mm, ch.sleeve_diameter_mm
-    F: list[Figure] = []
-
-    def add(key, label, value, unit, note="", digits=3):
-        F.append(Figure(key, label, float(value), unit, PAPER.get(key), note, digits))
-
-    # --- geometry (eqs. 6-8) ---
     z_initial = iso606.teeth_for_pitch_diameter(p, sp.initial_pitch_diameter_mm)
     d = iso606.every_other_tooth_pitch_diameter(p, z)
     df = d - dr
@@ -91,8 +102,12 @@ def calc(params: Params) -> list[Figure]:
     bf_max = iso606.iso_tooth_width_max(ch.sleeve_inner_width_mm, p)
     add("iso_tooth_width_max_mm", "ISO 606 tooth width bf1 max (from b1)", bf_max, "mm",
         f"chosen {sp.tooth_width_mm:g} mm")
+    return d, gap, lim
 
-    # --- track plate over the tip ---
+
+def _plate(params: Params, add, gap) -> None:
+    """The track plate over the tip: the plate offset for the chosen gap, the gap measured."""
+    tp, p = params.track_plate, params.chain.pitch_mm
     pin_line = analysis.link_pin_line_radius(gap)
     e = analysis.plate_offset_for_tip_gap(gap, tp.tip_gap_mm)
     outline = iso606.sprocket_outline(gap, GAP_CHECK_STEP_MM)
@@ -105,7 +120,10 @@ def calc(params: Params) -> list[Figure]:
         f"{word}: paper requires {tp.required_gap_min_mm:g}–{tp.required_gap_max_mm:g} mm")
     add("tip_gap_ok", "tip gap within the paper's window (1 = pass)", ok, "", word, 0)
 
-    # --- loads (eq. 1) ---
+
+def _loads(params: Params, add, d: float) -> tuple[float, float]:
+    """Eq. 1: weight, drive force, the design load on one tooth; the slope."""
+    r, gr = params.robot, params.ground
     weight = r.mass_kg * r.g_m_s2
     drive = analysis.drive_force_N(r.mass_kg, r.g_m_s2, gr.adhesion_coefficient,
                                    gr.rolling_resistance_coefficient, r.tracks)
@@ -130,8 +148,12 @@ def calc(params: Params) -> list[Figure]:
     add("sprocket_speed_rpm", "sprocket speed at v", r.speed_m_s * 60_000.0 / (math.pi * d), "rpm", digits=1)
     add("drive_torque_per_track_Nm", "sprocket torque at P_Kφ", drive * d / 2000.0, "N·m", digits=2)
     add("drive_power_per_track_W", "drive power per track P_Kφ·v", drive * r.speed_m_s, "W", digits=0)
+    return drive, design
 
-    # --- pin shear ---
+
+def _pin(params: Params, add, drive: float) -> None:
+    """Pin shear (and bending, for information) at the drive force."""
+    ch, st = params.chain, params.strength
     tau = analysis.pin_shear_stress_MPa(drive, ch.pin_segments, ch.pin_diameter_mm)
     ok, word = _verdict(tau <= st.pin_allowable_shear_MPa)
     add("pin_shear_stress_MPa", "pin shear stress 4V/3A (P_Kφ)", tau, "MPa",
@@ -144,7 +166,11 @@ def calc(params: Params) -> list[Figure]:
                                         ch.pin_support_span_mm, ch.pin_diameter_mm),
         "MPa", "span b2, load over b1; the paper checks shear only", 1)
 
-    # --- crush stress (eq. 10) ---
+
+def _crush(params: Params, add, design: float, lim) -> None:
+    """Eq. 10: Hertz crush stress of the sleeve in its groove."""
+    sp, st, mat = params.sprocket, params.strength, params.materials
+    dr = params.chain.sleeve_diameter_mm
     sleeve_r = dr / 2.0
     length = sp.tooth_width_mm * st.loaded_tooth_rows
     elastic = (mat.sleeve_E_MPa, mat.sleeve_poisson, mat.sprocket_E_MPa, mat.sprocket_poisson)
@@ -165,7 +191,6 @@ def calc(params: Params) -> list[Figure]:
     add("crush_safety_factor", "crush safety factor", st.allowable_crush_stress_MPa / concave.peak_pressure_MPa,
         "", word, 2)
     add("crush_ok", "crush stress (1 = pass)", ok, "", word, 0)
-    return F
 
 
-__all__ = ["SECTION", "Params", "calc", "PAPER"]
+__all__ = ["MESH_TOL_MM", "PAPER", "Params", "calc"]

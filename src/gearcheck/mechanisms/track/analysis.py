@@ -1,4 +1,4 @@
-"""Analytical model of the track-drive sprocket (seed 002), numpy only.
+"""Analytical model of the track-drive sprocket of a bomb-disposal robot, numpy only.
 
 Reconstruction of the paper's lost equations, readings and choices: docs/track.md. In short:
 

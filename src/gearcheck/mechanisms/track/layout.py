@@ -1,11 +1,12 @@
 """The numbers the track drive's CAD is built from (numpy only): the sprocket spec (ISO 606
 groove, rows, hub, bore), the link section and the chain segment wrapped at θ = 0.
 
-One source of truth for two users: :mod:`gearcheck.cad.sprocket` turns this layout into solids,
-and the template model (:mod:`gearcheck.mechanisms.track.params`) builds the same layout in its
-validator, so a parameter set the CAD could not build is rejected first, with a one-line error.
-Each function raises ``ValueError`` (:class:`~gearcheck.geometry.iso606.ToothFormError` for the
-groove) when the numbers leave no valid part.
+One source of truth for two users: the mechanism's assembly (:mod:`.assembly`) poses these
+specs, which :mod:`gearcheck.cad.sprocket` turns into solids, and the template model
+(:mod:`gearcheck.mechanisms.track.params`) builds the same layout in its validator, so a
+parameter set the CAD could not build is rejected first, with a one-line error. Each function
+raises ``ValueError`` (:class:`~gearcheck.geometry.iso606.ToothFormError` for the groove) when
+the numbers leave no valid part.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 
 from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
+from gearcheck.geometry.sprocket import SprocketSpec
 from gearcheck.mechanisms.track import analysis
 
 # Depth of the middle (guide-lug) groove's floor below the root circle r = d/2 − ri. The paper's
@@ -35,25 +37,6 @@ class BoreTooLarge(ValueError):
 
 class RowsWithoutGroove(ValueError):
     """Two or more tooth rows with no middle groove between them (a zero-length hub)."""
-
-
-@dataclass(frozen=True)
-class SprocketSpec:
-    """Everything the sprocket solid needs (mm)."""
-
-    gap: iso606.ToothGap
-    tooth_width_mm: float
-    tooth_rows: int
-    middle_groove_width_mm: float
-    hub_radius_mm: float
-    bore_radius_mm: float
-
-    def row_z_ranges(self) -> list[tuple[float, float]]:
-        """(z_low, z_high) of each tooth row, symmetric about z = 0."""
-        pitch = self.tooth_width_mm + self.middle_groove_width_mm
-        total = self.tooth_rows * self.tooth_width_mm + (self.tooth_rows - 1) * self.middle_groove_width_mm
-        return [(-total / 2 + i * pitch, -total / 2 + i * pitch + self.tooth_width_mm)
-                for i in range(self.tooth_rows)]
 
 
 def hub_radius_mm(pitch_diameter_mm: float, seating_radius_mm: float,

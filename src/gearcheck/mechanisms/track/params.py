@@ -1,4 +1,4 @@
-"""Template model of the track-drive sprocket (seed 002): every input of the paper, nothing derived.
+"""Template model of the track-drive sprocket: every input of the paper, nothing derived.
 
 Field ranges are physical limits; the cross-field rules (odd tooth count, a tooth left between
 adjacent grooves, the ISO 606 seating limits, a tip land left under the tip circle, widths that
@@ -68,7 +68,8 @@ class Sprocket(Section):
 
 
 class TrackPlate(Section):
-    tip_gap_mm: float = _f(TIP_GAP_MIN_MM, 5, unit="mm", description="chosen gap from tooth tip to a seated link's plate")
+    tip_gap_mm: float = _f(TIP_GAP_MIN_MM, 5, unit="mm",
+                           description="chosen gap from tooth tip to a seated link's plate")
     required_gap_min_mm: float = _f(0, 5, unit="mm", description="paper's required gap, lower end")
     required_gap_max_mm: float = _f(0, 5, unit="mm", description="paper's required gap, upper end")
 
@@ -97,7 +98,7 @@ class Params(Section):
     strength: Strength
 
     @model_validator(mode="after")
-    def _cross_checks(self) -> "Params":
+    def _cross_checks(self) -> Params:
         s, c = self.sprocket, self.chain
         z, p, dr = s.teeth, c.pitch_mm, c.sleeve_diameter_mm
         if z % 2 == 0:
@@ -134,6 +135,14 @@ class Params(Section):
                              f"allowed {lim.seating_angle_min_deg:.2f} to {lim.seating_angle_max_deg:.2f}°: "
                              f"ISO 606 limits for z = {z}")
         self._check_tip_land(d)
+        self._check_widths_and_loads()
+        self._check_buildable()
+        return self
+
+    def _check_widths_and_loads(self) -> None:
+        """Tooth width, rows and track width; loaded rows; adhesion; the paper's gap window."""
+        s, c = self.sprocket, self.chain
+        p = c.pitch_mm
         bf_max = iso606.iso_tooth_width_max(c.sleeve_inner_width_mm, p)
         if not s.tooth_width_mm <= bf_max:
             raise ParamError("sprocket.tooth_width_mm", s.tooth_width_mm,
@@ -158,8 +167,6 @@ class Params(Section):
         if not t.required_gap_min_mm <= t.required_gap_max_mm:
             raise ParamError("track_plate.required_gap_min_mm", t.required_gap_min_mm,
                              f"allowed <= required_gap_max_mm = {t.required_gap_max_mm:g} mm")
-        self._check_buildable()
-        return self
 
     def _check_buildable(self) -> None:
         """Build the layout `gearcheck build` builds its solids from (:mod:`.layout`, the same

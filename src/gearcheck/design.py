@@ -1,0 +1,164 @@
+"""A design: one validated template (which mechanism, its parameters, the resolved data), and
+what can be done with it from Python — calc, build, check, a CadQuery assembly.
+
+``gearcheck.load(...)`` returns a :class:`Design`. Loading and ``calc`` import neither CadQuery
+nor FCL; ``build``/``check``/``assembly_cad`` import them when called.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from gearcheck import mechanism as registry
+from gearcheck.params import ParamError, apply_overrides, read_toml, validate
+from gearcheck.params.common import MISSING, apply_values
+
+if TYPE_CHECKING:
+    from pydantic import BaseModel
+
+    from gearcheck.executor import Executor
+    from gearcheck.figures import Figure
+    from gearcheck.pipeline import BuildRun, CheckRun
+
+# An optional top-level `name` names the result files; it must be a plain folder name.
+NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
+
+
+@dataclass(frozen=True)
+class Calc:
+    """The analytical model's figures for a design (what ``gearcheck calc`` prints)."""
+
+    section: str
+    figures: list[Figure]
+
+    def to_dict(self) -> dict:
+        """The object ``gearcheck calc ... --json`` prints."""
+        from gearcheck.figures import figures_to_json
+
+        return figures_to_json(self.section, self.figures)
+
+    def __getitem__(self, key: str) -> float:
+        for f in self.figures:
+            if f.key == key:
+                return f.value
+        raise KeyError(key)
+
+
+@dataclass(frozen=True)
+class Design:
+    """A validated template: its mechanism, parameters, and the resolved (overridden) data."""
+
+    path: Path | None
+    mechanism: str
+    params: BaseModel
+    data: dict
+
+    @property
+    def impl(self) -> registry.Mechanism:
+        """The mechanism's implementation (from the registry)."""
+        return registry.get(self.mechanism)
+
+    @property
+    def source(self) -> str:
+        return str(self.path) if self.path is not None else "<data>"
+
+    @property
+    def name(self) -> str:
+        """Result name: the template's optional top-level ``name``, else the file's stem (so a
+        rerun from ``out/NAME/params.toml`` keeps NAME), else the mechanism's name."""
+        if self.data.get("name"):
+            return str(self.data["name"])
+        return self.path.stem if self.path is not None else self.mechanism
+
+    @property
+    def resolved_data(self) -> dict:
+        """The resolved parameters with the result name recorded, as written to params.toml."""
+        rest = {k: v for k, v in self.data.items() if k not in ("mechanism", "name")}
+        return {"mechanism": self.mechanism, "name": self.name, **rest}
+
+    def default_tol_mm(self) -> float:
+        return self.impl.mesh_tol_mm
+
+    # -- what a user does with a design --------------------------------------------------------
+    def calc(self) -> Calc:
+        """The analytical model (numpy only)."""
+        return Calc(self.impl.section, self.impl.analyse(self.params))
+
+    def build(self, out: str | Path | None = None, *, tol: float | None = None) -> BuildRun:
+        """Build the CAD and write what ``gearcheck build`` writes into ``out`` (default out/NAME)."""
+        from gearcheck import pipeline
+
+        return pipeline.build(self, Path(out) if out is not None else Path("out") / self.name, tol_mm=tol)
+
+    def check(self, out: str | Path | None = None, *, tol: float | None = None, jobs: int | None = None,
+              executor: Executor | None = None, options: Mapping[str, Any] | None = None) -> CheckRun:
+        """Build, sweep and report as ``gearcheck check`` does, into ``out`` (default out/NAME).
+        ``jobs``: worker processes (default every core; 1 runs in this process)."""
+        from gearcheck import pipeline
+
+        return pipeline.check(self, Path(out) if out is not None else Path("out") / self.name, tol_mm=tol,
+                              jobs=jobs, executor=executor, options=options)
+
+    def assembly_cad(self):
+        """A named, coloured ``cadquery.Assembly`` of the parts as built (shows in ocp_vscode)."""
+        from gearcheck.cad.export import cad_assembly
+
+        impl = self.impl
+        return cad_assembly(impl.parts(impl.assembly(self.params)), self.name)
+
+
+def _check_name(data: dict, source: str) -> None:
+    name = data.get("name")
+    if name is not None and not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)):
+        raise ParamError("name", name, "allowed 1 to 64 characters of A-Z a-z 0-9 _ . - (a folder name)", source)
+
+
+def from_data(data: dict, path: Path | None = None) -> Design:
+    """Validate template data (the ``mechanism`` key names the mechanism)."""
+    source = str(path) if path is not None else "<data>"
+    mech = data.get("mechanism")
+    known = registry.names()
+    if not isinstance(mech, str) or mech not in known:
+        raise ParamError("mechanism", mech if mech is not None else MISSING,
+                         f"allowed one of: {', '.join(known)}", source)
+    _check_name(data, source)
+    body = {k: v for k, v in data.items() if k not in ("mechanism", "name")}
+    params = validate(registry.get(mech).Params, body, source)
+    return Design(path=path, mechanism=mech, params=params, data=data)
+
+
+def load(template: str | Path | Mapping[str, Any],
+         overrides: Mapping[str, Any] | Sequence[str] | None = None) -> Design:
+    """Read, override and validate a template: a path to a TOML file, or a dict shaped like one.
+
+    ``overrides``: ``{"shim.thickness_mm": 0.15}`` (Python values) or ``["shim.thickness_mm=0.15"]``
+    (``--set`` strings, read as TOML values). Raises :class:`ParamError` (one line naming the
+    field, its value and the allowed range) on any bad input."""
+    if isinstance(template, Mapping):
+        path, source = None, "<data>"
+        import copy
+
+        data = copy.deepcopy(dict(template))
+    else:
+        path = Path(template)
+        source = str(path)
+        data = read_toml(path)
+    try:
+        if isinstance(overrides, Mapping):
+            data = apply_values(data, dict(overrides))
+        elif overrides:
+            if isinstance(overrides, str):
+                raise ParamError("overrides", overrides, "expected a dict or a list of 'section.key=value'")
+            data = apply_overrides(data, list(overrides))
+    except ParamError as exc:
+        raise exc.with_source(source) from None
+    return from_data(data, path)
+
+
+def load_template(path: str | Path, overrides: list[str] | None = None) -> Design:
+    """A template file with ``--set`` overrides (the CLI's form of :func:`load`)."""
+    return load(Path(path), overrides or [])

@@ -1,0 +1,54 @@
+"""One bisection for every "where does it change" search (numpy-free): contact along a motion
+coordinate in the sweeps, an event angle, the edge of a parameter's allowed range.
+
+``flag(x)`` is False at ``free`` and True at ``touching``; the bracket is halved until it is no
+wider than ``tol`` (or for ``max_iter`` halvings), keeping one end on each side.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+# Bisection stops when the bracket is this narrow (mm or rad, by caller), unless told otherwise.
+DEFAULT_TOL = 1e-6
+DEFAULT_MAX_ITER = 200
+
+
+@dataclass(frozen=True)
+class Bracket:
+    """Where ``flag`` changes: False at ``free``, True at ``touching``."""
+
+    free: float
+    touching: float
+
+    @property
+    def value(self) -> float:
+        return 0.5 * (self.free + self.touching)
+
+    @property
+    def width(self) -> float:
+        return abs(self.touching - self.free)
+
+
+def bisect(flag: Callable[[float], bool], free: float, touching: float, tol: float | None = DEFAULT_TOL,
+           max_iter: int = DEFAULT_MAX_ITER, check_ends: bool = True) -> Bracket:
+    """Halve [free, touching] (either order) keeping ``flag`` False at one end and True at the other.
+
+    With ``check_ends`` the ends are tested first and a bracket that does not hold raises
+    ValueError (a motion that never reaches contact proves nothing about clearance). ``tol``
+    None: exactly ``max_iter`` halvings."""
+    if check_ends:
+        if flag(free):
+            raise ValueError(f"start {free!r} already has the flag (no bracket)")
+        if not flag(touching):
+            raise ValueError(f"end {touching!r} does not reach the flag (no bracket)")
+    for _ in range(max_iter):
+        if tol is not None and abs(touching - free) <= tol:
+            break
+        mid = 0.5 * (free + touching)
+        if flag(mid):
+            touching = mid
+        else:
+            free = mid
+    return Bracket(free, touching)

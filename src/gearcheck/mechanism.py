@@ -1,0 +1,226 @@
+"""The mechanism interface: what a mechanism implements once, and the registry that finds them.
+
+A mechanism is one package with one class deriving from :class:`Mechanism`. Each hook does one
+job, and data flows one way through them::
+
+    Params ──analyse──▶ figures (calc)
+       └──assembly──▶ Assembly (part specs, poses, motions: numpy)
+                         └──parts──▶ solids (the only hook that touches gearcheck.cad)
+                         └──plan(assembly, meshed bodies)──▶ SweepPlan (picklable tasks + reduce)
+                                         └──reduce──▶ SweepOutcome ──verdicts──▶ [Verdict]
+                                                                    └──report──▶ Report
+
+:mod:`gearcheck.pipeline` runs them (build → mesh → sweep → resolution rule → exact
+confirmation → files); the CLI, the Python API, the benchmarks and the tests call the pipeline.
+
+Registration: the entry-point group ``gearcheck.mechanisms`` (``name = "package.module:Class"``
+in a package's metadata; gearcheck's own three are declared in its pyproject.toml), or
+:func:`register` at run time. Nothing else lists the mechanisms.
+"""
+
+from __future__ import annotations
+
+import logging
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from importlib.metadata import entry_points
+from typing import TYPE_CHECKING, Any, ClassVar
+
+import numpy as np
+
+if TYPE_CHECKING:  # type names only: importing a mechanism costs neither CadQuery nor FCL
+    from pydantic import BaseModel
+
+    from gearcheck.cad.placement import Part
+    from gearcheck.figures import Figure
+    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.sweep.bodies import Body, MeshData
+    from gearcheck.sweep.motion import Motion
+
+log = logging.getLogger("gearcheck")
+
+ENTRY_POINT_GROUP = "gearcheck.mechanisms"
+
+
+@dataclass(frozen=True)
+class PartSpec:
+    """One part of an assembly as data: which solid it is (``solid``: a key of
+    :attr:`Assembly.solids`; copies share one key, so the solid is built and meshed once), its
+    pose as built (4×4, frame → world), material, display colour, motion and the named
+    sub-solids (features) the CAD hook builds with it for exact confirmations."""
+
+    name: str
+    solid: str
+    material: str
+    pose: np.ndarray
+    color: tuple[float, float, float] = (0.7, 0.7, 0.75)
+    motion: Motion | None = None
+    features: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Assembly:
+    """A mechanism's parts as data (numpy only): the part specs in build order, the geometry
+    spec of each distinct solid (what the CAD hook builds from), and the mechanism's own layout
+    (the numbers its sweep plan works from, derived from the parameters once, here)."""
+
+    mechanism: str
+    parts: tuple[PartSpec, ...]
+    solids: Mapping[str, Any]
+    layout: Any = None
+
+    def __post_init__(self) -> None:
+        names = [p.name for p in self.parts]
+        if len(set(names)) != len(names):
+            raise ValueError(f"part names must be unique: {names}")
+        missing = sorted({p.solid for p in self.parts} - set(self.solids))
+        if missing:
+            raise ValueError(f"parts refer to solids with no spec: {missing}")
+
+    def part(self, name: str) -> PartSpec:
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    @property
+    def names(self) -> list[str]:
+        return [p.name for p in self.parts]
+
+
+Task = tuple[Callable[..., Any], tuple]
+
+
+@dataclass
+class SweepPlan:
+    """A sweep as data: the meshes every worker builds its scene from, the tasks (each a
+    module-level function ``fn(scene, *args)`` and its picklable arguments: no CadQuery), the
+    progress units of each task, and the reduce step that turns the task results (in task
+    order) into a :class:`~gearcheck.results.SweepOutcome` in this process."""
+
+    meshes: list[MeshData]
+    tasks: list[Task]
+    reduce: Callable[[list], SweepOutcome]
+    weights: list[int] | None = None
+    unit: str = "pose"
+    options: dict = field(default_factory=dict)
+
+    @property
+    def total(self) -> int:
+        return sum(self.weights) if self.weights is not None else len(self.tasks)
+
+
+class Mechanism(ABC):
+    """One mechanism, implemented once. Subclasses set the class attributes and the hooks."""
+
+    #: registry name and the ``mechanism`` key of its templates
+    name: ClassVar[str]
+    #: the JSON section of calc --json and summary.json
+    section: ClassVar[str]
+    #: one line for --help and the docs
+    title: ClassVar[str]
+    #: the pydantic model of its template (every section but ``mechanism`` and ``name``)
+    Params: ClassVar[type[BaseModel]]
+    #: meshing tolerance when --tol is not given (fine enough for the template's clearances)
+    mesh_tol_mm: ClassVar[float]
+    #: the shipped template's file name (in templates/), if it has one
+    template: ClassVar[str | None] = None
+    #: calc figures documented as NaN when the model has no value
+    nan_figures: ClassVar[frozenset[str]] = frozenset()
+    #: verdicts that test gearcheck itself (mesh sweep vs an independent exact model): a random
+    #: design may fail a design verdict, never one of these
+    consistency_verdicts: ClassVar[tuple[str, ...]] = ("mesh_agrees_with_exact",)
+    #: first seed of its random sets in `make fuzz` (disjoint streams: a set is reproducible alone)
+    fuzz_seed_base: ClassVar[int] = 0
+
+    # -- numpy only ---------------------------------------------------------------------------
+    @abstractmethod
+    def analyse(self, params: Any) -> list[Figure]:
+        """The analytical model: the figures ``calc`` prints (numpy only)."""
+
+    @abstractmethod
+    def assembly(self, params: Any) -> Assembly:
+        """The parts as data: specs, poses as built, motions (numpy only)."""
+
+    # -- the CAD hook -------------------------------------------------------------------------
+    @abstractmethod
+    def parts(self, assembly: Assembly) -> list[Part]:
+        """Solids for the part specs, in the order of ``assembly.parts``: calls
+        :mod:`gearcheck.cad` with the specs (cad/ never imports a mechanism)."""
+
+    # -- the sweep ----------------------------------------------------------------------------
+    @abstractmethod
+    def plan(self, params: Any, assembly: Assembly, bodies: Mapping[str, Body],
+             options: Mapping[str, Any] | None = None) -> SweepPlan:
+        """The sweep for the meshed bodies (keyed by part name, posed as ``assembly`` built
+        them); ``options`` override sampling densities (tests, fuzz, studies)."""
+
+    @abstractmethod
+    def verdicts(self, params: Any, outcome: SweepOutcome) -> list[Verdict]:
+        """Pass / warn / fail claims from the sweep's outcome (names unique)."""
+
+    @abstractmethod
+    def report(self, params: Any, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
+        """Rows for sweep.csv, comparison rows, plots and notes for report.html."""
+
+    # -- fuzzing ------------------------------------------------------------------------------
+    def sample(self, data: dict, draw: Any) -> None:
+        """Redraw the knobs of a template body in place (``draw``: a
+        :class:`gearcheck.mechanisms.sampling.Draw`). Default: no sampler."""
+        raise NotImplementedError(f"{self.name}: no fuzz sampler")
+
+    def fuzz_options(self, params: Any) -> dict:
+        """Sweep options for a fuzzed design (cheaper sampling where a mechanism needs it)."""
+        return {}
+
+
+# ------------------------------------------------------------------------------------------
+# Registry
+
+_registered: dict[str, Mechanism] = {}
+_entry_points: dict[str, Any] | None = None
+
+
+def _discovered() -> dict[str, Any]:
+    global _entry_points  # noqa: PLW0603 - read the installed metadata once per process
+    if _entry_points is None:
+        _entry_points = {ep.name: ep for ep in entry_points(group=ENTRY_POINT_GROUP)}
+    return _entry_points
+
+
+def register(mechanism: Mechanism | type[Mechanism]) -> Mechanism:
+    """Add a mechanism at run time (a test's, a notebook's); returns the instance."""
+    instance = mechanism() if isinstance(mechanism, type) else mechanism
+    if not isinstance(instance, Mechanism):
+        raise TypeError(f"{instance!r} is not a gearcheck Mechanism")
+    _registered[instance.name] = instance
+    return instance
+
+
+def unregister(name: str) -> None:
+    _registered.pop(name, None)
+
+
+def names() -> list[str]:
+    """Every known mechanism: installed entry points first (sorted), then run-time ones."""
+    found = sorted(_discovered())
+    return found + sorted(n for n in _registered if n not in found)
+
+
+def get(name: str) -> Mechanism:
+    """The mechanism called ``name`` (imports its package on first use). KeyError if unknown."""
+    if name in _registered:
+        return _registered[name]
+    ep = _discovered().get(name)
+    if ep is None:
+        raise KeyError(name)
+    cls = ep.load()
+    instance = register(cls)
+    if instance.name != name:
+        raise ValueError(f"entry point {name!r} loads a mechanism named {instance.name!r}")
+    return instance
+
+
+def all_mechanisms() -> list[Mechanism]:
+    return [get(n) for n in names()]

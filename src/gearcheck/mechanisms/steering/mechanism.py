@@ -1,0 +1,64 @@
+"""The nose-wheel steering rack and pinion as a :class:`gearcheck.mechanism.Mechanism`: each hook
+wired to the module that does its job."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any, ClassVar
+
+from gearcheck.mechanism import Assembly, Mechanism, SweepPlan
+from gearcheck.mechanisms.steering import assembly as _assembly
+from gearcheck.mechanisms.steering import calc as _calc
+from gearcheck.mechanisms.steering import report as _report
+from gearcheck.mechanisms.steering import sampling as _sampling
+from gearcheck.mechanisms.steering import sweep as _sweep
+from gearcheck.mechanisms.steering import verdicts as _verdicts
+from gearcheck.mechanisms.steering.params import Params as SteeringParams
+
+if TYPE_CHECKING:
+    from gearcheck.cad.placement import Part
+    from gearcheck.figures import Figure
+    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.sweep.bodies import Body
+
+
+class Steering(Mechanism):
+    """Trimmed end teeth, continuous power drive, towing disengage and re-engage."""
+
+    name: ClassVar[str] = "steering"
+    section: ClassVar[str] = "steering"
+    title: ClassVar[str] = "nose-wheel steering rack and pinion: trimmed end teeth, towing disengage"
+    Params = SteeringParams
+    # Zero backlash: no non-zero clearance is checked, contact is decided within the sum of the
+    # two meshes' bounds (0.02 mm at this tolerance).
+    mesh_tol_mm: ClassVar[float] = 0.01
+    template: ClassVar[str | None] = "nose_wheel_steering.toml"
+    fuzz_seed_base: ClassVar[int] = 2_000_000
+    nan_figures: ClassVar[frozenset[str]] = _sampling.NAN_FIGURES
+
+    def analyse(self, params: SteeringParams) -> list[Figure]:
+        return _calc.calc(params)
+
+    def assembly(self, params: SteeringParams) -> Assembly:
+        return _assembly.assembly(params)
+
+    def parts(self, assembly: Assembly) -> list[Part]:
+        from gearcheck.mechanisms.steering.parts import parts
+
+        return parts(assembly)
+
+    def plan(self, params: SteeringParams, assembly: Assembly, bodies: Mapping[str, Body],
+             options: Mapping[str, Any] | None = None) -> SweepPlan:
+        return _sweep.plan(params, assembly, bodies, options)
+
+    def verdicts(self, params: SteeringParams, outcome: SweepOutcome) -> list[Verdict]:
+        return _verdicts.verdicts(params, outcome)
+
+    def report(self, params: SteeringParams, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
+        return _report.report(params, outcome, verdicts)
+
+    def sample(self, data: dict, draw: Any) -> None:
+        _sampling.sample(data, draw)
+
+    def fuzz_options(self, params: SteeringParams) -> dict:
+        return {}

@@ -1,0 +1,66 @@
+"""The track drive sprocket as a :class:`gearcheck.mechanism.Mechanism`: the hooks wired to the
+package's modules (analysis, assembly, CAD hook, sweep plan, verdicts, report, sampler)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import TYPE_CHECKING, Any
+
+from gearcheck.mechanism import Assembly, Mechanism, SweepPlan
+from gearcheck.mechanisms.track import MESH_TOL_MM, calc
+from gearcheck.mechanisms.track.assembly import track_assembly
+from gearcheck.mechanisms.track.params import Params as TrackParams
+
+if TYPE_CHECKING:
+    from gearcheck.cad.placement import Part
+    from gearcheck.figures import Figure
+    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.sweep.bodies import Body
+
+
+class TrackDrive(Mechanism):
+    """Track-drive sprocket of a bomb-disposal robot: ISO 606 groove form, every other tooth
+    engaging, a wrapped segment of track links (docs/track.md, docs/sprocket_cad.md)."""
+
+    name = "track"
+    section = "track"
+    title = "track drive sprocket: ISO 606 form, every other tooth engaging"
+    Params = TrackParams
+    mesh_tol_mm = MESH_TOL_MM
+    template = "eod_track_drive.toml"
+    fuzz_seed_base = 1_000_000
+
+    def analyse(self, params: TrackParams) -> list[Figure]:
+        return calc(params)
+
+    def assembly(self, params: TrackParams) -> Assembly:
+        return track_assembly(params)
+
+    def parts(self, assembly: Assembly) -> list[Part]:
+        from gearcheck.mechanisms.track.parts import build_parts
+
+        return build_parts(assembly)
+
+    def plan(self, params: TrackParams, assembly: Assembly, bodies: Mapping[str, Body],
+             options: Mapping[str, Any] | None = None) -> SweepPlan:
+        from gearcheck.mechanisms.track.sweep import plan_sweep
+
+        return plan_sweep(assembly, bodies, options)
+
+    def verdicts(self, params: TrackParams, outcome: SweepOutcome) -> list[Verdict]:
+        from gearcheck.mechanisms.track.verdicts import track_verdicts
+
+        return track_verdicts(outcome)
+
+    def report(self, params: TrackParams, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
+        from gearcheck.mechanisms.track.report import track_report
+
+        return track_report(outcome, verdicts)
+
+    def sample(self, data: dict, draw: Any) -> None:
+        from gearcheck.mechanisms.track.sampling import sample_track
+
+        sample_track(data, draw)
+
+    def fuzz_options(self, params: TrackParams) -> dict:
+        return {}

@@ -1,0 +1,434 @@
+"""Track drive sweep: the sprocket turns, the chain advances, links swing into and out of mesh;
+FCL on the generated meshes measures tooth–sleeve clearance and tip-to-plate distance at every
+pose, and an exact 2-D model (:mod:`gearcheck.geometry.track_section`) checks every figure.
+
+Poses are data (:class:`gearcheck.geometry.track_chain.ChainWrap`): at drive angle θ the sprocket
+is ``sprocket_matrix(θ)`` and link j is ``wrap.link_matrices(θ)[j]``; every link body shares one
+mesh in the link frame. One engagement cycle is β = 2·360°/z of sprocket rotation; after it every
+pose repeats with the pin numbers shifted by one and the sprocket turned by two grooves, which is
+one of its symmetries. So sweeping θ over one cycle moves every link of the segment through its
+own stretch of the path, and together they cover the whole path (entry run, swinging in, seated,
+swinging out, exit run). The sweep runs from −margin to β + margin so both ends of the cycle are
+inside it.
+
+The link solid is the sleeve fused with the plate, but the two clearances belong to different
+features: the sleeve sits in its seat (ri − R, 0.1 mm) and the plate face over the tooth tip
+(the tip gap, 0.75 mm). The link mesh is therefore split by position in the link frame
+(:func:`split_link_mesh`): triangles whose vertices all lie within R of the pin axis are the
+sleeve, the rest the plate.
+
+The mesh sweep must agree with the exact 2-D model within the mesh-error bound at every pose and
+link; the worst clearances are then proven from both sides (free at −tol, touching at +tol) in
+this process.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from gearcheck.geometry import iso606
+from gearcheck.geometry import track_chain as tc
+from gearcheck.geometry.track_section import ExactSection
+from gearcheck.mechanism import Assembly, SweepPlan
+from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
+from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
+from gearcheck.results import Clearance, SweepOutcome, WorstPose
+from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
+from gearcheck.sweep.engine import Scene
+from gearcheck.sweep.tools import ContactProof, prove_contact
+
+# Sprocket angles per engagement cycle β (step β/60 = 0.245°: a seated pin moves 0.50 mm per step,
+# far less than the 8 mm sleeve, so no body can pass through another between poses).
+STEPS_PER_CYCLE = 60
+# The sweep runs this fraction of a cycle before θ = 0 and after θ = β.
+CYCLE_MARGIN_FRACTION = 0.125
+DEFAULT_OPTIONS = {"steps_per_cycle": STEPS_PER_CYCLE, "margin_fraction": CYCLE_MARGIN_FRACTION}
+# Contact is judged with this tolerance, or the mesh-error bound if that is larger: pushed by the
+# measured gap − tolerance the pair must be free, by gap + tolerance it must collide.
+CONTACT_TOLERANCE_MM = 0.02
+# Bisection on the push distance stops at this bracket width.
+BISECTION_TOL_MM = 1e-5
+# A link-mesh triangle belongs to the sleeve when all its vertices lie within R + this of the pin
+# axis (mesh vertices lie on the B-rep surfaces; plate triangles reach out to the plate's far edges).
+SLEEVE_SELECT_MARGIN_MM = 1e-4
+# Rounding of measured values against the paper's window (report precision, 1 µm).
+WINDOW_ROUNDING_MM = 1e-6
+
+SLEEVE, PLATE = "sleeve", "plate"
+
+
+def split_link_mesh(mesh: MeshData, sleeve_radius_mm: float,
+                    margin_mm: float = SLEEVE_SELECT_MARGIN_MM) -> tuple[MeshData, MeshData]:
+    """(sleeve, plate) sub-meshes of the fused link mesh (link frame: pin axis = z axis).
+
+    Sleeve: triangles with every vertex within R + margin of the pin axis (its cylinder and the
+    discs of its end faces); plate: the rest. The pieces are open surfaces, which is all FCL's
+    mesh distance and collision need.
+    """
+    v, f = mesh.vertices, mesh.faces
+    radius = np.hypot(v[:, 0], v[:, 1])
+    on_sleeve = np.all(radius[f] <= sleeve_radius_mm + margin_mm, axis=1)
+    if on_sleeve.all() or not on_sleeve.any():
+        raise ValueError("link mesh does not split into sleeve and plate")
+    return submesh(mesh, SLEEVE, on_sleeve), submesh(mesh, PLATE, ~on_sleeve)
+
+
+def sweep_angles(wrap: tc.ChainWrap, steps_per_cycle: int = STEPS_PER_CYCLE,
+                 margin_fraction: float = CYCLE_MARGIN_FRACTION) -> np.ndarray:
+    """θ from −margin to β + margin in steps of β/steps_per_cycle; 0 and β are samples."""
+    before = int(math.ceil(margin_fraction * steps_per_cycle))
+    k = np.arange(-before, steps_per_cycle + before + 1)
+    return k * wrap.cycle_rad / steps_per_cycle
+
+
+# --------------------------------------------------------------------------------------------
+# The task (runs in worker processes)
+
+_EXACT_CACHE: dict = {}
+
+
+def exact_section(model: TrackModel) -> ExactSection:
+    """One exact model per process and template (workers receive the model with every pose)."""
+    key = model.key()
+    if key not in _EXACT_CACHE:
+        _EXACT_CACHE.clear()
+        _EXACT_CACHE[key] = ExactSection(model.gap, model.link)
+    return _EXACT_CACHE[key]
+
+
+def evaluate_pose(scene: Scene, model: TrackModel, angle_rad: float) -> np.ndarray:
+    """(links, 5) per link at drive angle θ: mesh sprocket–sleeve distance, mesh sprocket–plate
+    distance (mm), whether the sprocket and the whole link mesh intersect (1/0), and the exact
+    2-D sleeve clearance and plate distance at the same pose."""
+    exact = exact_section(model)
+    sprocket = tc.sprocket_matrix(angle_rad)
+    scene.set_pose(SPROCKET, sprocket)
+    poses = model.wrap.link_matrices(angle_rad)
+    out = np.empty((len(poses), 5))
+    for j, pose in enumerate(poses):
+        scene.set_poses({SLEEVE: pose, PLATE: pose, LINK: pose})
+        out[j, 0] = scene.distance(SPROCKET, SLEEVE).distance
+        out[j, 1] = scene.distance(SPROCKET, PLATE).distance
+        out[j, 2] = scene.collide(SPROCKET, LINK)
+        out[j, 3:] = exact.link_distances(sprocket, pose)
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# The plan
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """What the reduce step needs from the plan (this process only)."""
+
+    model: TrackModel
+    names: list[str]
+    meshes: list[MeshData]
+    bound: float
+    contact_tol: float
+    angles: np.ndarray
+    started: float
+
+
+def link_names(assembly: Assembly) -> list[str]:
+    return [p.name for p in assembly.parts if p.solid == LINK]
+
+
+def sweep_options(options: Mapping[str, Any] | None) -> dict:
+    unknown = sorted(set(options or {}) - set(DEFAULT_OPTIONS))
+    if unknown:
+        raise ValueError(f"track sweep: unknown options {unknown}; known: {sorted(DEFAULT_OPTIONS)}")
+    return {**DEFAULT_OPTIONS, **(options or {})}
+
+
+def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None = None) -> SweepPlan:
+    """One task per sprocket angle (:func:`evaluate_pose`), over the sprocket, the link mesh split
+    into sleeve and plate, and the whole link."""
+    opts = sweep_options(options)
+    model: TrackModel = assembly.layout
+    names = link_names(assembly)
+    first = bodies[names[0]].mesh
+    for n in names[1:]:
+        m = bodies[n].mesh
+        if m.vertices.shape != first.vertices.shape or not np.array_equal(m.faces, first.faces):
+            raise ValueError("link bodies do not share one mesh")
+    sleeve_mesh, plate_mesh = split_link_mesh(first, model.sleeve_radius_mm)
+    meshes = [bodies[SPROCKET].mesh, sleeve_mesh, plate_mesh, MeshData(LINK, first.vertices, first.faces)]
+    bound = pair_error_bound(dict(bodies), SPROCKET, names[0])
+    angles = sweep_angles(model.wrap, int(opts["steps_per_cycle"]), float(opts["margin_fraction"]))
+    tasks = [(evaluate_pose, (model, float(a))) for a in angles]
+    setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter())
+    return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts)
+
+
+# --------------------------------------------------------------------------------------------
+# Reduce
+
+
+@dataclass(frozen=True)
+class Extreme:
+    value: float
+    pose_index: int
+    link: int
+
+
+def _argmin(values: np.ndarray, mask: np.ndarray) -> Extreme:
+    masked = np.where(mask, values, np.inf)
+    i, j = np.unravel_index(int(np.argmin(masked)), masked.shape)
+    return Extreme(float(masked[i, j]), int(i), int(j))
+
+
+def rowmin(values: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    return np.where(mask, values, np.inf).min(axis=1)
+
+
+def finite(x: float, fallback: float = -1.0) -> float:
+    """Summary leaves must be plain finite numbers."""
+    return float(x) if math.isfinite(x) else fallback
+
+
+@dataclass(frozen=True)
+class TrackSweep:
+    """The reduced sweep (``SweepOutcome.data``): per-pose arrays, extremes, contact proofs."""
+
+    model: TrackModel
+    angles: np.ndarray
+    names: list[str]
+    sleeve_d: np.ndarray  # (poses, links) mesh distances
+    plate_d: np.ndarray
+    hits: np.ndarray
+    ex_sleeve: np.ndarray  # (poses, links) exact 2-D distances
+    ex_plate: np.ndarray
+    links_seated: np.ndarray
+    sleeve_seated: np.ndarray
+    x: dict[str, Extreme]  # the extremes, by name (mesh; "ex_…": exact)
+    seated_gap_max: float
+    max_dev: float
+    bound: float
+    contact_tol: float
+    gap_proof: ContactProof
+    sleeve_proof: ContactProof
+    gap_point_link: np.ndarray
+    whole_link_at_sleeve: float
+    model_gap: float
+    sleeve_triangles: int
+    plate_triangles: int
+    outline_step_mm: float
+    sagitta_mm: float
+    sweep_s: float
+    proof_s: float
+
+    @property
+    def collisions(self) -> int:
+        return int(self.hits.sum())
+
+    @property
+    def colliding_poses(self) -> np.ndarray:
+        return np.flatnonzero(self.hits.any(axis=1))
+
+    @property
+    def seated_counts(self) -> np.ndarray:
+        return self.links_seated.sum(axis=1)
+
+    @property
+    def cycle_deg(self) -> float:
+        return float(np.degrees(self.model.wrap.cycle_rad))
+
+    def where(self, x: Extreme, sleeve: bool = False) -> str:
+        """The link, its state and the angle of an extreme, in words."""
+        seated, what = (self.sleeve_seated, "sleeve") if sleeve else (self.links_seated, "link")
+        state = "seated" if seated[x.pose_index, x.link] else "off its seat"
+        return f"{self.names[x.link]} ({what} {state}) at θ = {np.degrees(self.angles[x.pose_index]):.3f}°"
+
+
+def _extremes(sleeve_d, plate_d, ex_sleeve, ex_plate, links_seated, sleeve_seated) -> dict[str, Extreme]:
+    everything = np.ones_like(links_seated)
+    return {
+        "min_sleeve": _argmin(sleeve_d, everything),
+        "min_plate": _argmin(plate_d, everything),
+        "seated_gap": _argmin(plate_d, links_seated),
+        "seated_sleeve": _argmin(sleeve_d, sleeve_seated),
+        "off_sleeve": _argmin(sleeve_d, ~sleeve_seated),
+        "off_plate": _argmin(plate_d, ~links_seated),
+        "ex_min_sleeve": _argmin(ex_sleeve, everything),
+        "ex_min_plate": _argmin(ex_plate, everything),
+        "ex_seated_gap": _argmin(ex_plate, links_seated),
+        "ex_seated_sleeve": _argmin(ex_sleeve, sleeve_seated),
+        "ex_off_sleeve": _argmin(ex_sleeve, ~sleeve_seated),
+        "ex_off_plate": _argmin(ex_plate, ~links_seated),
+    }
+
+
+def _proofs(setup: _Setup, x: dict, sleeve_seated: np.ndarray) -> dict:
+    """Contact from both sides at the worst poses (in this process): the seated plate pushed to
+    the tip, the worst sleeve pushed into its seat (or towards the nearest tooth point); the
+    poses of the worst sleeve and plate, and the whole link's distance at the sleeve's pose."""
+    angles, wrap = setup.angles, setup.model.wrap
+    t2 = time.perf_counter()
+    scene = Scene(setup.meshes)
+
+    def place(index: int) -> tuple[np.ndarray, np.ndarray]:
+        a = float(angles[index])
+        s = tc.sprocket_matrix(a)
+        scene.set_pose(SPROCKET, s)
+        return s, wrap.link_matrices(a)
+
+    seated_gap, min_sleeve, min_plate = x["seated_gap"], x["min_sleeve"], x["min_plate"]
+    _, links_gap = place(seated_gap.pose_index)
+    pose_gap = links_gap[seated_gap.link]
+    inward = -pose_gap[:3, 1]  # the link's −y: from the plate face towards the sprocket axis
+    gap_proof = prove_contact(scene, SPROCKET, PLATE, pose_gap, inward, seated_gap.value, setup.contact_tol,
+                              "plate pushed towards the axis (plate alone: the sleeve would seat first)",
+                              BISECTION_TOL_MM)
+    scene.set_pose(PLATE, pose_gap)
+    near_gap = scene.distance(SPROCKET, PLATE)
+    gap_point_link = np.linalg.solve(pose_gap, np.append(near_gap.point_b, 1.0))[:2]
+
+    s_sl, links_sl = place(min_sleeve.pose_index)
+    pose_sl = links_sl[min_sleeve.link]
+    if sleeve_seated[min_sleeve.pose_index, min_sleeve.link]:
+        direction = -pose_sl[:3, 3] * np.array([1.0, 1.0, 0.0])  # radially in, into the seat
+        how = "sleeve pushed radially into its seat"
+    else:
+        scene.set_pose(SLEEVE, pose_sl)
+        near = scene.distance(SPROCKET, SLEEVE)
+        direction = near.point_a - near.point_b  # from the sleeve's nearest point to the tooth's
+        how = "sleeve pushed towards the nearest tooth point"
+    sleeve_proof = prove_contact(scene, SPROCKET, SLEEVE, pose_sl, direction, min_sleeve.value, setup.contact_tol,
+                                 how, BISECTION_TOL_MM)
+    proof_s = time.perf_counter() - t2
+
+    # whole-link distance at the sleeve's worst pose (what an exact B-rep distance of the whole
+    # link will measure)
+    scene.set_pose(LINK, pose_sl)
+    whole_link_at_sleeve = scene.distance(SPROCKET, LINK).distance
+    s_pl, links_pl = place(min_plate.pose_index)
+    pose_pl = links_pl[min_plate.link]
+    return {"gap_proof": gap_proof, "sleeve_proof": sleeve_proof, "gap_point_link": gap_point_link,
+            "whole_link_at_sleeve": float(whole_link_at_sleeve), "s_sl": s_sl, "pose_sl": pose_sl,
+            "s_pl": s_pl, "pose_pl": pose_pl, "proof_s": proof_s}
+
+
+def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
+    """Extremes over all poses and links, contact proofs at the worst poses, the summary, the
+    worst poses for exact confirmation and the smallest clearance decided on."""
+    sweep_s = time.perf_counter() - setup.started
+    model, angles, names, bound = setup.model, setup.angles, setup.names, setup.bound
+    wrap = model.wrap
+    out = np.array(results)  # (poses, links, 5)
+    sleeve_d, plate_d, hits = out[..., 0], out[..., 1], out[..., 2] > 0.5
+    ex_sleeve, ex_plate = out[..., 3], out[..., 4]
+    exact = exact_section(model)
+    pins_seated = np.array([wrap.seated_pins(a) for a in angles])
+    links_seated = pins_seated[:, :-1] & pins_seated[:, 1:]
+    sleeve_seated = pins_seated[:, :-1]  # link j carries the sleeve on pin j
+
+    # compared where the mesh sees the link within half the exact model's reach (farther links
+    # do not matter for any minimum; an exact inf there is a disagreement)
+    dev_sleeve = np.abs(np.where(sleeve_d < exact.reach_mm / 2, sleeve_d - ex_sleeve, 0.0))
+    dev_plate = np.abs(np.where(plate_d < exact.reach_mm / 2, plate_d - ex_plate, 0.0))
+    max_dev = float(max(dev_sleeve.max(), dev_plate.max()))
+    x = _extremes(sleeve_d, plate_d, ex_sleeve, ex_plate, links_seated, sleeve_seated)
+    seated_gap_max = float(np.where(links_seated, plate_d, -np.inf).max())
+
+    pr = _proofs(setup, x, sleeve_seated)
+    min_sleeve, min_plate = x["min_sleeve"], x["min_plate"]
+    s_sl, pose_sl, s_pl, pose_pl = pr["s_sl"], pr["pose_sl"], pr["s_pl"], pr["pose_pl"]
+    gap_proof, sleeve_proof, gap_point_link = pr["gap_proof"], pr["sleeve_proof"], pr["gap_point_link"]
+    whole_link_at_sleeve, proof_s = pr["whole_link_at_sleeve"], pr["proof_s"]
+    # the analytical model's tip gap, as `gearcheck calc` measures it on the 2-D outline
+    model_gap = analysis.measured_tip_gap(iso606.sprocket_outline(model.gap, GAP_CHECK_STEP_MM), model.gap,
+                                          wrap.pitch_mm, model.link.plate_offset_mm)
+
+    data = TrackSweep(model, angles, names, sleeve_d, plate_d, hits, ex_sleeve, ex_plate, links_seated,
+                      sleeve_seated, x, seated_gap_max, max_dev, bound, setup.contact_tol, gap_proof, sleeve_proof,
+                      gap_point_link, float(whole_link_at_sleeve), model_gap, len(setup.meshes[1].faces),
+                      len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s)
+    worst = [
+        WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
+                  names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),
+        WorstPose(f"track: min tip-to-plate distance, {data.where(min_plate)} (plate alone)", SPROCKET,
+                  f"{names[min_plate.link]}.plate", s_pl.tolist(), pose_pl.tolist(), min_plate.value),
+    ]
+    n_poses = len(angles)
+    timings = {"sweep_s": sweep_s, "poses_per_s": n_poses / sweep_s,
+               "link_poses_per_s": n_poses * wrap.links / sweep_s, "contact_proof_s": proof_s}
+    clearances = [(v, what) for v, what in ((x["ex_min_sleeve"].value, "least tooth–sleeve clearance"),
+                                            (x["ex_min_plate"].value, "least tip-to-plate distance")) if v > 0.0]
+    least = min(clearances) if clearances else None
+    clearance = Clearance(float(least[0]), f"{least[1]} (exact 2-D)") if least else None
+    return SweepOutcome(summary(data), worst, clearance, timings, data)
+
+
+def summary(d: TrackSweep) -> dict:
+    """summary.json's track section (the verdicts are added beside it)."""
+    x, model, angles, wrap = d.x, d.model, d.angles, d.model.wrap
+    deg = np.degrees
+    seated_counts = d.seated_counts
+    n_poses = len(angles)
+    return {
+        "min_tip_plate_distance_mm": x["min_plate"].value,
+        "min_tip_plate_angle_deg": float(deg(angles[x["min_plate"].pose_index])),
+        "min_tip_plate_link": x["min_plate"].link,
+        "min_tip_plate_link_seated": int(d.links_seated[x["min_plate"].pose_index, x["min_plate"].link]),
+        "min_tip_plate_unseated_mm": finite(x["off_plate"].value),
+        "min_tip_plate_unseated_angle_deg": float(deg(angles[x["off_plate"].pose_index])),
+        "seated_tip_gap_mm": x["seated_gap"].value,
+        "seated_tip_gap_max_mm": d.seated_gap_max,
+        "seated_tip_gap_angle_deg": float(deg(angles[x["seated_gap"].pose_index])),
+        "seated_tip_gap_link": x["seated_gap"].link,
+        "template_tip_gap_mm": model.tip_gap_mm,
+        "model_tip_gap_mm": d.model_gap,
+        "min_tooth_sleeve_clearance_mm": x["min_sleeve"].value,
+        "min_tooth_sleeve_angle_deg": float(deg(angles[x["min_sleeve"].pose_index])),
+        "min_tooth_sleeve_link": x["min_sleeve"].link,
+        "min_tooth_sleeve_seated": int(d.sleeve_seated[x["min_sleeve"].pose_index, x["min_sleeve"].link]),
+        "seated_sleeve_clearance_mm": x["seated_sleeve"].value,
+        "min_tooth_sleeve_unseated_mm": finite(x["off_sleeve"].value),
+        "min_tooth_sleeve_unseated_angle_deg": float(deg(angles[x["off_sleeve"].pose_index])),
+        "model_seating_clearance_mm": model.seating_clearance_mm,
+        "exact": {
+            "min_tip_plate_distance_mm": x["ex_min_plate"].value,
+            "seated_tip_gap_mm": x["ex_seated_gap"].value,
+            "min_tip_plate_unseated_mm": finite(x["ex_off_plate"].value),
+            "min_tooth_sleeve_clearance_mm": x["ex_min_sleeve"].value,
+            "seated_sleeve_clearance_mm": x["ex_seated_sleeve"].value,
+            "min_tooth_sleeve_unseated_mm": finite(x["ex_off_sleeve"].value),
+            "max_mesh_deviation_mm": d.max_dev,
+            "outline_step_mm": d.outline_step_mm,
+            "sagitta_bound_mm": d.sagitta_mm,
+        },
+        "contact": {
+            "tip_gap_free_mm": finite(d.gap_proof.free_mm),
+            "tip_gap_touching_mm": finite(d.gap_proof.touching_mm),
+            "tip_gap_free_at_minus_tol": int(d.gap_proof.free_at_minus),
+            "tip_gap_touching_at_plus_tol": int(d.gap_proof.touching_at_plus),
+            "seat_free_mm": finite(d.sleeve_proof.free_mm),
+            "seat_touching_mm": finite(d.sleeve_proof.touching_mm),
+            "seat_free_at_minus_tol": int(d.sleeve_proof.free_at_minus),
+            "seat_touching_at_plus_tol": int(d.sleeve_proof.touching_at_plus),
+        },
+        "mesh_error_bound_mm": d.bound,
+        "contact_tolerance_mm": d.contact_tol,
+        "collisions": d.collisions,
+        "poses": n_poses,
+        "links": wrap.links,
+        "link_poses": n_poses * wrap.links,
+        "cycle_deg": d.cycle_deg,
+        "cycles_covered": float((angles[-1] - angles[0]) / wrap.cycle_rad),
+        "sweep_start_deg": float(deg(angles[0])),
+        "sweep_end_deg": float(deg(angles[-1])),
+        "step_deg": float(deg(angles[1] - angles[0])),
+        "seated_links_min": int(seated_counts.min()),
+        "seated_links_max": int(seated_counts.max()),
+        "min_at_seated_links": int(x["ex_off_plate"].value >= x["ex_seated_gap"].value - WINDOW_ROUNDING_MM
+                                   and x["ex_off_sleeve"].value >= x["ex_seated_sleeve"].value - WINDOW_ROUNDING_MM),
+    }

@@ -1,0 +1,274 @@
+"""The one pipeline: build → mesh → sweep (through an executor) → mesh-resolution rule → exact
+B-rep confirmation → files. The CLI, the Python API, the benchmarks and the tests all call it.
+
+Each stage is a function of the previous stage's output, so a caller can stop anywhere:
+:func:`build_parts` (solids, no files), :func:`build` (solids, meshes, STEP/STL/manifest),
+:func:`sweep` (a :class:`~gearcheck.results.CheckResult` from meshed bodies, no files),
+:func:`check` (everything, with report files). Nothing here prints: progress goes to the
+``progress`` factory a caller passes (the CLI's bars), diagnostics to the ``gearcheck`` logger.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import time
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Protocol
+
+from gearcheck.params import ParamError
+from gearcheck.results import CheckResult, Confirmation
+
+if TYPE_CHECKING:
+    from gearcheck.cad.export import ExportedPart
+    from gearcheck.cad.placement import Part
+    from gearcheck.design import Design
+    from gearcheck.executor import Executor
+    from gearcheck.mechanism import Assembly
+    from gearcheck.sweep.bodies import Body
+
+log = logging.getLogger("gearcheck")
+
+# --tol: the meshing tolerances a user may ask for (mm).
+TOL_MIN_MM = 0.0005
+TOL_MAX_MM = 0.5
+REPORT_FILES = ("summary.json", "sweep.csv", "report.html")
+
+
+class Bar(Protocol):
+    def update(self, n: int = 1) -> Any: ...
+
+
+ProgressFactory = Callable[[str, "int | None", str], contextlib.AbstractContextManager[Bar]]
+
+
+class _NoBar:
+    def update(self, n: int = 1) -> None:
+        return None
+
+
+@contextlib.contextmanager
+def no_progress(_desc: str, _total: int | None = None, _unit: str = "") -> Iterator[Bar]:
+    yield _NoBar()
+
+
+def check_tol(tol_mm: float | None) -> None:
+    """``--tol`` within the range a mesh can be made and measured at."""
+    if tol_mm is not None and not (TOL_MIN_MM <= tol_mm <= TOL_MAX_MM):
+        raise ParamError("--tol", tol_mm, f"out of range: allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm")
+
+
+def mesh_tol(design: Design, tol_mm: float | None) -> float:
+    """--tol, or the mechanism's default (fine enough for the template's smallest clearance)."""
+    return tol_mm if tol_mm is not None else design.impl.mesh_tol_mm
+
+
+# ------------------------------------------------------------------------------------------
+# Build
+
+
+@dataclass
+class BuildRun:
+    """What ``build`` made: the assembly as data, the solids, the meshes (as sweep bodies), the
+    manifest and the files written."""
+
+    design: Design
+    folder: Path
+    tol_mm: float
+    assembly: Assembly
+    parts: list[Part]
+    exported: list[ExportedPart]
+    bodies: dict[str, Body]
+    manifest: dict
+    files: list[Path] = field(default_factory=list)
+
+
+def build_parts(design: Design) -> tuple[Assembly, list[Part]]:
+    """The assembly as data and its solids (CadQuery), no files."""
+    impl = design.impl
+    assembly = impl.assembly(design.params)
+    parts = impl.parts(assembly)
+    if [p.name for p in parts] != assembly.names:
+        raise RuntimeError(f"{impl.name}: parts() must return the assembly's parts in order, "
+                           f"got {[p.name for p in parts]} for {assembly.names}")
+    return assembly, parts
+
+
+def sweep_bodies(exported: list[ExportedPart]) -> dict[str, Body]:
+    """Meshed parts as the sweep sees them: plain arrays in each part's own frame, its pose as
+    built, its measured mesh-error bound (picklable: no CAD kernel needed to use them)."""
+    import numpy as np
+
+    from gearcheck.sweep.bodies import Body, MeshData
+
+    return {
+        e.part.name: Body(MeshData(e.part.name, e.mesh.vertices, e.mesh.faces), np.asarray(e.part.pose, float),
+                          e.mesh.error_bound_mm, e.part.material, e.part.motion)
+        for e in exported
+    }
+
+
+def build(design: Design, folder: Path, *, tol_mm: float | None = None,
+          progress: ProgressFactory = no_progress) -> BuildRun:
+    """Build the CAD, mesh each part at ``tol_mm`` (default: the mechanism's), and write
+    NAME.step, PART.stl, params.toml and manifest.json into ``folder`` (each atomically)."""
+    from gearcheck.cad.export import export_parts
+    from gearcheck.output import ensure_out_dir
+
+    check_tol(tol_mm)
+    folder = ensure_out_dir(folder).absolute()  # the files stay findable after a chdir
+    tol = mesh_tol(design, tol_mm)
+    log.debug("building %s (%s)", design.name, design.mechanism)
+    assembly, parts = build_parts(design)
+    with progress(f"meshing {design.name}", len(parts), "part") as bar:
+        manifest, exported = export_parts(parts, folder, name=design.name, mechanism=design.mechanism,
+                                          params_data=design.resolved_data, tol_mm=tol,
+                                          progress=lambda _name: bar.update(1))
+    files = [folder / manifest["step"]["file"], *(folder / p["stl"]["file"] for p in manifest["parts"]),
+             folder / manifest["params_file"]["file"], folder / "manifest.json"]
+    return BuildRun(design, folder, tol, assembly, parts, exported, sweep_bodies(exported), manifest, files)
+
+
+# ------------------------------------------------------------------------------------------
+# Sweep
+
+
+def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, executor: Executor | None = None,
+          jobs: int | None = None, options: Mapping[str, Any] | None = None,
+          progress: ProgressFactory = no_progress) -> CheckResult:
+    """Plan the mechanism's sweep on the meshed bodies, run its tasks on ``executor`` (default:
+    a local pool of ``jobs`` processes, every core), reduce, and give verdicts and report
+    content. No files; the mesh-resolution rule and the exact confirmation come after."""
+    from gearcheck.executor import make_executor
+    from gearcheck.sweep.plan import make_scene, run_task
+
+    impl = design.impl
+    check_poses(assembly, bodies)
+    executor = executor if executor is not None else make_executor(jobs)
+    plan = impl.plan(design.params, assembly, bodies, options)
+    t0 = time.perf_counter()
+    with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar:
+        results = executor.map(run_task, plan.tasks, setup=make_scene, shared=plan.meshes,
+                               progress=bar.update, weights=plan.weights)
+    log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs,
+             time.perf_counter() - t0)
+    outcome = plan.reduce(results)
+    verdicts = impl.verdicts(design.params, outcome)
+    report = impl.report(design.params, outcome, verdicts)
+    timings = dict(outcome.timings)
+    timings.setdefault("workers", executor.jobs)
+    return CheckResult(impl.section, outcome.summary, verdicts, report.rows, report.comparisons, report.plots,
+                       report.notes, outcome.worst_poses, timings, outcome.smallest_clearance)
+
+
+def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
+    """The bodies must be this assembly's parts, posed as it built them (a sweep of meshes built
+    from other parameters would prove nothing about this design)."""
+    import numpy as np
+
+    for spec in assembly.parts:
+        if spec.name not in bodies:
+            raise ValueError(f"missing body {spec.name!r}: expected the parts {assembly.names}")
+        if not np.allclose(bodies[spec.name].pose, spec.pose, atol=1e-9):
+            raise ValueError(f"{spec.name}: pose differs from the assembly's (built with other parameters?)")
+
+
+def apply_resolution_rule(design: Design, result: CheckResult, bodies: Mapping[str, Body],
+                          tol_mm: float) -> None:
+    """After meshing and sweeping: meshes too coarse for the smallest clearance checked are bad
+    input (``--tol``, one line); otherwise the rule's figures join the summary and the notes."""
+    from gearcheck import resolution
+
+    why = resolution.violation(result, dict(bodies))
+    if why is not None:
+        raise ParamError("--tol", tol_mm, why, design.source)
+    result.summary["mesh_resolution"] = resolution.resolution_summary(result, dict(bodies))
+    result.notes.append(resolution.describe(result, dict(bodies)))
+
+
+def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
+            progress: ProgressFactory = no_progress) -> list[Confirmation]:
+    """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
+    from gearcheck.cad.confirm import exact_distance
+    from gearcheck.sweep.tools import mesh_nearest_midpoint
+
+    by_name = {p.name: p for p in parts}
+    out = []
+    with progress("exact B-rep distance at worst poses", len(result.worst_poses), "pose") as bar:
+        for worst in result.worst_poses:
+            bound = sum(bodies[n.partition(".")[0]].error_bound_mm for n in (worst.part_a, worst.part_b))
+            brep = exact_distance(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
+            out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
+                                    worst.mesh_distance_mm, brep, bound))
+            bar.update(1)
+    return out
+
+
+# ------------------------------------------------------------------------------------------
+# Check
+
+
+@dataclass
+class CheckRun:
+    """A finished check: the build, the result, the files written."""
+
+    build: BuildRun
+    result: CheckResult
+    files: list[Path]
+    summary: dict  # summary.json, as written
+
+    @property
+    def folder(self) -> Path:
+        return self.build.folder
+
+    @property
+    def passed(self) -> bool:
+        return self.result.passed
+
+    @property
+    def verdicts(self):
+        return self.result.verdicts
+
+
+def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict) -> tuple[list[Path], dict]:
+    """summary.json, sweep.csv and report.html (each atomically); the files and summary.json's data."""
+    from gearcheck.output import atomic_write_text
+    from gearcheck.report.files import summary_json, sweep_csv
+    from gearcheck.report.html import render
+
+    summary = summary_json(result)
+    atomic_write_text(folder / "summary.json", summary)
+    atomic_write_text(folder / "sweep.csv", sweep_csv(result))
+    build_info = {
+        "chordal_tolerance_mm": manifest["chordal_tolerance_mm"],
+        "triangles": sum(p["triangles"] for p in manifest["parts"]),
+        "parts": len(manifest["parts"]),
+    }
+    page = render(result, title=f"gearcheck: {design.name} ({design.mechanism})", template=design.source,
+                  build=build_info)
+    atomic_write_text(folder / "report.html", page)
+    return [folder / n for n in REPORT_FILES], json.loads(summary)
+
+
+def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: int | None = None,
+          executor: Executor | None = None, options: Mapping[str, Any] | None = None,
+          progress: ProgressFactory = no_progress) -> CheckRun:
+    """Build into ``folder``, sweep, apply the mesh-resolution rule, confirm the worst poses on
+    the exact B-rep and write report.html, summary.json and sweep.csv beside the CAD."""
+    from gearcheck.output import ensure_out_dir
+
+    check_tol(tol_mm)
+    folder = ensure_out_dir(folder)
+    # the report files of an earlier run would describe other meshes: gone until this run writes its own
+    for stale in REPORT_FILES:
+        (folder / stale).unlink(missing_ok=True)
+    run = build(design, folder, tol_mm=tol_mm, progress=progress)
+    result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
+                   progress=progress)
+    apply_resolution_rule(design, result, run.bodies, run.tol_mm)
+    result.confirmations = confirm(result, run.parts, run.bodies, progress)
+    files, summary = write_report(design, folder, result, run.manifest)
+    return CheckRun(run, result, run.files + files, summary)

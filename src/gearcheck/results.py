@@ -1,0 +1,186 @@
+"""Typed results: what a mechanism's check hands to the report and to Python callers.
+
+Plain data (stdlib only): the report layer, the CLI and the Python API read these without
+CadQuery or FCL. ``summary`` stays a nested dict of plain numbers because it *is* summary.json;
+everything with a meaning of its own (a verdict, a comparison row, a plot, a pose to confirm)
+is a dataclass.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+Level = Literal["pass", "warn", "fail"]
+LEVELS: tuple[Level, ...] = ("pass", "warn", "fail")
+
+
+@dataclass(frozen=True)
+class Verdict:
+    """One claim about the design or about the evidence, with the figures that decide it.
+
+    ``name`` is its key in summary.json (``verdicts.NAME``: 1 unless the level is "fail"), unique
+    within a check; ``label`` says what is claimed, ``measured`` what was measured against which
+    limit, in one line; ``figures`` the deciding numbers, for a program."""
+
+    name: str
+    label: str
+    level: Level
+    measured: str
+    figures: Mapping[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.level not in LEVELS:
+            raise ValueError(f"verdict {self.name!r}: level {self.level!r} is not one of {LEVELS}")
+
+    @classmethod
+    def of(cls, name: str, label: str, passed: bool, measured: str,
+           figures: Mapping[str, float] | None = None) -> Verdict:
+        """A pass/fail verdict."""
+        return cls(name, label, "pass" if passed else "fail", measured, dict(figures or {}))
+
+    @property
+    def passed(self) -> bool:
+        """True unless the level is "fail" (a warning does not fail a design)."""
+        return self.level != "fail"
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """One row of the paper vs model vs geometry table (None where a column has no value)."""
+
+    label: str
+    unit: str
+    paper: float | None
+    model: float | None
+    geometry: float | None
+    note: str = ""
+    exact: float | None = None  # an independent exact (non-mesh) model, where there is one
+
+
+@dataclass(frozen=True)
+class Series:
+    label: str
+    x: list[float]
+    y: list[float]
+    style: Literal["line", "points"] = "line"
+
+
+@dataclass(frozen=True)
+class Plot:
+    title: str
+    xlabel: str
+    ylabel: str
+    series: list[Series]
+    markers: list[tuple[str, float]] = field(default_factory=list)  # vertical lines: (label, x)
+    hlines: list[tuple[str, float]] = field(default_factory=list)  # horizontal lines: (label, y)
+
+
+@dataclass(frozen=True)
+class WorstPose:
+    """A pose to confirm with an exact B-rep distance (the report shows both figures).
+
+    Poses are world transforms of each part's own frame; ``scale_*`` the thermal scale of each
+    part about its own frame origin (1 when warm). A scale s about another datum d is the scale
+    about the origin followed by the shift (1 − s)·d in the part's frame: fold that shift into
+    the pose (pose @ translation((1 − s)·d)). A part name may name one feature of a part
+    ("link_03.plate")."""
+
+    label: str
+    part_a: str
+    part_b: str
+    pose_a: list
+    pose_b: list
+    mesh_distance_mm: float
+    scale_a: float = 1.0
+    scale_b: float = 1.0
+    key: str = ""  # JSON key in summary.json; default: made from the label
+
+    @property
+    def json_key(self) -> str:
+        if self.key:
+            return self.key
+        slug = "".join(c if c.isascii() and c.isalnum() else "_" for c in self.label.lower())
+        return "_".join(filter(None, slug.split("_")))[:80]
+
+
+@dataclass(frozen=True)
+class Clearance:
+    """The smallest non-zero clearance a check decides a verdict on (from its exact model, not
+    the mesh), for the mesh-resolution rule (:mod:`gearcheck.resolution`)."""
+
+    value_mm: float
+    label: str  # what it is, with the figure in the check's own units
+
+
+@dataclass(frozen=True)
+class Confirmation:
+    """A worst pose re-measured on the exact B-rep."""
+
+    label: str
+    key: str  # JSON key under exact_confirmation
+    parts: str  # "a / b"
+    mesh_mm: float
+    brep_mm: float
+    bound_mm: float
+
+    def figures(self) -> dict[str, float]:
+        return {"mesh_mm": self.mesh_mm, "brep_mm": self.brep_mm, "bound_mm": self.bound_mm}
+
+
+@dataclass
+class SweepOutcome:
+    """What a mechanism's sweep reduced to, before verdicts: the figures (summary.json's
+    section, plain numbers), the poses to confirm exactly, the smallest clearance decided on,
+    wall-clock figures (never in summary.json) and anything the mechanism's verdicts and
+    report need (``data``, mechanism-specific)."""
+
+    summary: dict
+    worst_poses: list[WorstPose] = field(default_factory=list)
+    smallest_clearance: Clearance | None = None
+    timings: dict = field(default_factory=dict)
+    data: Any = None
+
+
+@dataclass
+class Report:
+    """A mechanism's report content: per-pose rows (sweep.csv), comparison rows, plots, notes."""
+
+    rows: list[dict] = field(default_factory=list)
+    comparisons: list[Comparison] = field(default_factory=list)
+    plots: list[Plot] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class CheckResult:
+    """Everything one mechanism's check produced."""
+
+    section: str  # the mechanism's JSON section ("differential", "track", "steering", ...)
+    summary: dict  # nested, plain numeric leaves (lists of numbers allowed for study tables)
+    verdicts: list[Verdict]
+    rows: list[dict]  # one per pose, flat, same keys in every row: sweep.csv
+    comparisons: list[Comparison] = field(default_factory=list)
+    plots: list[Plot] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # findings in words, for the report
+    worst_poses: list[WorstPose] = field(default_factory=list)
+    # wall-clock figures (s, poses/s): for benchmarks and the terminal, never in summary.json,
+    # which must be byte-identical between runs
+    timings: dict = field(default_factory=dict)
+    # None: the mechanism checks no non-zero clearance (zero-backlash contact)
+    smallest_clearance: Clearance | None = None
+    confirmations: list[Confirmation] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        names = [v.name for v in self.verdicts]
+        if len(set(names)) != len(names):
+            raise ValueError(f"verdict names must be unique: {names}")
+
+    @property
+    def passed(self) -> bool:
+        return all(v.passed for v in self.verdicts)
+
+    @property
+    def failed(self) -> list[Verdict]:
+        return [v for v in self.verdicts if not v.passed]

@@ -1,0 +1,59 @@
+"""The executor seam and the typed motions (no CAD)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gearcheck.executor import ProcessExecutor, SerialExecutor, available_cores, make_executor
+from gearcheck.geometry.bisect import bisect
+from gearcheck.sweep.motion import ChainLink, Rotation, Translation
+
+
+def scaled(state: float, x: float, y: float) -> float:
+    return state * (x + y)
+
+
+def test_results_in_task_order_on_any_number_of_workers():
+    tasks = [(float(i), 0.5 * i) for i in range(37)]
+    expected = [3.0 * (x + y) for x, y in tasks]
+    ticks: list[int] = []
+    assert SerialExecutor().map(scaled, tasks, setup=float, shared=3.0, progress=ticks.append) == expected
+    assert sum(ticks) == 37
+    weighted: list[int] = []
+    assert ProcessExecutor(2).map(scaled, tasks, setup=float, shared=3.0, progress=weighted.append,
+                                  weights=[2] * 37) == expected
+    assert sum(weighted) == 74
+
+
+def test_make_executor_defaults_to_every_core_and_runs_serially_at_one():
+    assert isinstance(make_executor(1), SerialExecutor)
+    assert make_executor().jobs == available_cores() >= 1
+    with pytest.raises(ValueError):
+        make_executor(0)
+
+
+def test_rotation_is_rigid_about_its_axis_through_its_origin():
+    r = Rotation.about((0, 0, 2), (10.0, 0.0, 0.0))
+    m = r.matrix(math.pi / 2)
+    assert np.allclose(m @ [10.0, 0.0, 5.0, 1.0], [10.0, 0.0, 5.0, 1.0])  # points on the axis stay
+    assert np.allclose(m @ [11.0, 0.0, 0.0, 1.0], [10.0, 1.0, 0.0, 1.0])  # a quarter turn, right-handed
+    assert r.to_dict() == {"kind": "rotation", "axis": [0.0, 0.0, 1.0], "origin": [10.0, 0.0, 0.0]}
+    t = Translation.along((3, 0, 0))
+    assert np.allclose(t.matrix(2.0)[:3, 3], [2.0, 0.0, 0.0])
+    assert ChainLink(4).to_dict() == {"kind": "chain_link", "index": 4}
+    with pytest.raises(ValueError):
+        Rotation.about((0, 0, 0))
+
+
+def test_one_bisection_brackets_where_a_flag_changes():
+    b = bisect(lambda x: x >= 0.3, 0.0, 1.0, tol=1e-9)
+    assert b.free < 0.3 <= b.touching and b.width <= 1e-9
+    b = bisect(lambda x: x <= -0.25, 0.0, -1.0, tol=1e-9)  # either direction
+    assert b.touching <= -0.25 < b.free
+    with pytest.raises(ValueError):
+        bisect(lambda x: True, 0.0, 1.0)
+    steps = bisect(lambda x: x >= 0.3, 0.0, 1.0, tol=None, max_iter=10, check_ends=False)
+    assert steps.width == pytest.approx(2.0**-10)
