@@ -67,3 +67,19 @@ def test_meshes_too_coarse_for_the_clearance_are_rejected(first_run, tmp_path, t
     assert summary["rule_met"] == 1
     assert summary["largest_part_error_bound_mm"] <= summary["allowed_bound_mm"] == pytest.approx(0.1 * summary["smallest_clearance_mm"])
     assert summary["smallest_clearance_mm"] == pytest.approx(0.1, abs=1e-3)
+
+
+def test_one_worker_and_every_core_write_the_same_files(first_run, tmp_path, templates_dir):
+    """--jobs 1 runs the sweep in this process, the default on every core: byte-identical files."""
+    _, out = first_run
+    assert main(["check", str(templates_dir / "eod_track_drive.toml"), "--jobs", "1", "--out", str(tmp_path)]) == 0
+    for name in ("summary.json", "sweep.csv"):
+        assert (tmp_path / name).read_bytes() == (out / name).read_bytes(), name
+
+
+def test_jobs_must_be_a_whole_number_of_at_least_one(capsys, templates_dir):
+    with pytest.raises(SystemExit) as info:
+        main(["check", str(templates_dir / "eod_track_drive.toml"), "--jobs", "0"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and "--jobs = 0: allowed a whole number ≥ 1" in err
