@@ -31,9 +31,9 @@ from OCP.TopAbs import TopAbs_IN  # noqa: E402
 from gearcheck.cad.bevel import (build_bevel_gear, flank_faces, is_valid,  # noqa: E402
                                  volume_mm3)
 from gearcheck.cad.mesh import mesh_shape  # noqa: E402
-from gearcheck.geometry.bevel import (BevelGearSpec, analytic_volume_mm3,  # noqa: E402
-                                      flank_distance, mating_spec,
+from gearcheck.geometry.bevel import (BevelGearSpec, flank_distance, mating_spec,  # noqa: E402
                                       pitch_cone_tooth_thickness)
+from gearcheck.geometry.bevel_volume import analytic_volume_mm3  # noqa: E402
 
 PINION = BevelGearSpec(teeth=13, mate_teeth=33, module_mm=2.5, face_width_mm=14.0,
                        pressure_angle_deg=20.0, profile_shift=0.39, bore_mm=10.0)

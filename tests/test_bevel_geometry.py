@@ -7,7 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from gearcheck.geometry.bevel import (BevelGearSpec, analytic_volume_mm3, flank_azimuth,
+from gearcheck.geometry.bevel_volume import analytic_volume_mm3
+from gearcheck.geometry.bevel import (BevelGearSpec, flank_azimuth,
                                       flank_directions, flank_distance, gleason_profile_shift,
                                       involute_azimuth, line_of_action, mate_rotation,
                                       mating_spec, pitch_cone_tooth_thickness,

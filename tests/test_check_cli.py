@@ -50,18 +50,22 @@ def test_failing_verdict_exits_1(tmp_path, templates_dir):
 
 
 def test_meshes_too_coarse_for_the_clearance_are_rejected(first_run, tmp_path, templates_dir, capsys):
-    """After meshing, a mesh-error bound above 1/10 of the smallest clearance checked
-    (track: tooth–sleeve 0.100 mm) is a one-line --tol error, exit 2, and no report is left —
-    not even one from an earlier run in the same folder."""
+    """After meshing, a mesh-error bound above 1/10 of the smallest clearance checked (track:
+    tooth–sleeve 0.100 mm) is a one-line --tol error, exit 2 — and the folder keeps the previous
+    complete run, untouched (the rejected run was never swapped in)."""
+    import hashlib
+    import shutil
+
     _, out = first_run
-    for name in ("summary.json", "sweep.csv", "report.html"):
-        (tmp_path / name).write_bytes((out / name).read_bytes())
-    code = main(["check", str(templates_dir / "eod_track_drive.toml"), "--tol", "0.02", "--out", str(tmp_path)])
+    target = tmp_path / "run"
+    shutil.copytree(out, target)
+    before = {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in target.iterdir()}
+    code = main(["check", str(templates_dir / "eod_track_drive.toml"), "--tol", "0.02", "--out", str(target)])
     assert code == 2
     err = capsys.readouterr().err.strip().splitlines()[-1]
     assert "--tol = 0.02: allowed ≤ 0.009999 mm" in err and "tooth–sleeve" in err
-    for name in ("summary.json", "sweep.csv", "report.html"):
-        assert not (tmp_path / name).exists(), name
+    assert {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in target.iterdir()} == before
+    assert [p.name for p in tmp_path.iterdir() if ".staging-" in p.name] == []
     # the default run records the rule it met
     summary = json.loads((out / "summary.json").read_text())["track"]["mesh_resolution"]
     assert summary["rule_met"] == 1

@@ -171,7 +171,7 @@ def test_set_overrides_apply():
         ('gears.module_mm="abc"', "gears.module_mm", ["wrong type", "0.5 to 10.0 mm"]),
         ("gears.small_profile_shift=0", "gears.small_profile_shift", ["undercut", "0.183"]),
         ("gears.small_profile_shift=0.8", "gears.small_profile_shift", ["pointed", "0.625"]),
-        ("gears.face_width_mm=16", "gears.face_width_mm", ["14.78", "cone distance"]),
+        ("gears.face_width_mm=16", "gears.face_width_mm", ["14.77", "cone distance"]),
         ("gears.shaft_angle_deg=80", "gears.shaft_angle_deg", ["90"]),
         ("dimensions.b_mm=75", "dimensions.b_mm", ["69.500", "apex"]),
         ("shim.thickness_mm=2", "shim.thickness_mm", ["0.0 to 1.0 mm"]),

@@ -5,8 +5,8 @@ one line on stderr. Nothing else may escape (no traceback).
 Inputs: every byte prefix of every shipped template (truncation, cut UTF-8 sequences), random
 bytes, binary garbage and a BOM, random TOML documents built from the real section and key
 names with values of every TOML type (strings, huge integers such as 10**400, floats including
-nan/inf, booleans, dates, arrays, nested and deeply nested tables), unknown keys, and random
-`--set` overrides. Seeded (derandomized) so CI runs the same cases every time.
+nan/inf, booleans, dates, arrays, nested and deeply nested tables), unknown keys, long dotted
+keys (refused before parsing), and random `--set` overrides. Seeded (derandomized) so CI runs the same cases every time.
 """
 
 from __future__ import annotations
@@ -117,6 +117,14 @@ def test_random_bytes(folder, data):
         b"x = " + b"[" * 5_000 + b"]" * 5_000,
         b"x = " + b"{a = " * 3_000 + b"1" + b"}" * 3_000,
         b"[" + b".".join([b"a"] * 3_000) + b"]\nx = 1\n",
+        # long dotted keys: tomllib is quadratic on them (40,000 parts took 30 s, 6 GB), so the
+        # loader's pre-scan refuses them before parsing (tests/test_loader_limits.py times it)
+        b".".join([b"a"] * 40_000) + b" = 1\n",
+        b"x = {" + b".".join([b'"a"'] * 20_000) + b" = 1}\n",
+        b"mechanism = \"track\"\n[[" + b".".join([b"a"] * 20_000) + b"]]\n",
+        b"x = \"\"\"\n" + b".".join([b"a"] * 20_000) + b" = [[[[[[[[[[\n\"\"\"\n",  # in a string: not structure
+        b"x = [" + b"[], " * 20_000 + b"]\n",
+        b"k = 1\n" * 30_000,
         b"mechanism = \"differential\"\n[gears]\nmodule_mm = " + b"9" * 5_000 + b"\n",
         b"mechanism = \"differential\"\n[materials]\nhousing = \"" + b"x" * 100_000 + b"\"\n",
         b"mechanism = \"track\"\n" * 3,
@@ -279,6 +287,9 @@ def test_set_overrides_steering(key, value):
     "gears.module_mm=" + "[" * 3000,
     "gears.module_mm=" + "[" * 600 + "]" * 600,
     ".".join(["a"] * 500) + "=1",
+    ".".join(["a"] * 40_000) + "=1",
+    "gears.module_mm={" + ".".join(["a"] * 40_000) + " = 1}",
+    "gears.module_mm=1\n[" + ".".join(["a"] * 40_000) + "]",
     "mechanism=track",
     "mechanism.x=1",
     "gears=1",

@@ -9,16 +9,20 @@ gives a bound, a value just inside it passes that rule.
 
 from __future__ import annotations
 
+import copy
 import math
 import re
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
+from fuzz_support import draw_set
 from gearcheck.design import load_template
 from gearcheck.mechanism import get as mechanism
 from gearcheck.mechanisms.steering import analysis as steering_analysis
-from gearcheck.params import ParamError
-from gearcheck.params.common import apply_overrides, read_toml
+from gearcheck.params import ParamError, validate
+from gearcheck.params.common import apply_overrides, fmt_bound, fmt_range, read_toml
 
 DIFF = "zhurong_differential.toml"
 TRACK = "eod_track_drive.toml"
@@ -133,7 +137,8 @@ def test_contact_ratio_below_one_untrimmed(templates_dir):
 def test_bevel_face_width_over_a_third_of_the_cone_distance(templates_dir):
     exc = assert_rejects(templates_dir, DIFF, ["gears.face_width_mm=20"], "gears.face_width_mm",
                          "= 20.0:", "one third of the outer cone distance")
-    assert bound(exc, "<=") == pytest.approx(44.34 / 3, abs=0.01)  # Re = 2.5·√(33² + 13²)/2
+    third = 2.5 * math.hypot(33, 13) / 2 / 3  # Re/3, Re = 2.5·√(33² + 13²)/2 = 44.335 mm
+    assert third - 0.01 < bound(exc, "<=") <= third  # rounded down (inward): 14.77
     load_template(templates_dir / DIFF, [f"gears.face_width_mm={bound(exc, '<=') - 0.01:.2f}"])
 
 
@@ -332,3 +337,203 @@ def test_rack_teeth_must_leave_a_root_space(templates_dir):
     left, right = g.rack_tooth_polygon(0), g.rack_tooth_polygon(1)
     assert left[1, 0] > right[0, 0]  # bottom-right of one tooth beyond bottom-left of the next
     assert bound(exc, "<") == pytest.approx(math.pi / 4 / math.tan(math.radians(25)), abs=1e-3)
+
+
+# ====================================================================================
+# Printed bounds are rounded inward: the number a message prints after 'allowed' is itself
+# accepted (a closed bound) or has the values just beyond it, towards the range, accepted (an open
+# bound ">x", "<x": checked 1e-9 inside) — or, if another rule then fails, that
+# rejection names another field.
+NUMBER = r"(-?\d+(?:\.\d+)?)"
+RANGE = re.compile(rf"allowed (?:odd )?(>?){NUMBER} to (<?){NUMBER}")
+ONE_SIDED = re.compile(rf"allowed (>=|<=|>|<) ?{NUMBER}(?![\w.])")
+
+
+def printed_bounds(allowed: str) -> list[tuple[str, str, bool]]:
+    """(number as printed, 'lower' | 'upper', open) for each bound printed after 'allowed'."""
+    m = RANGE.search(allowed)
+    if m:
+        return [(m.group(2), "lower", m.group(1) == ">"), (m.group(4), "upper", m.group(3) == "<")]
+    m = ONE_SIDED.search(allowed)
+    if m:
+        return [(m.group(2), "lower" if m.group(1).startswith(">") else "upper", len(m.group(1)) == 1)]
+    return []
+
+
+def bound_value(text: str, side: str, is_open: bool, integer: bool):
+    """The value to try for a printed bound: the bound itself (closed) or, open, a hair inside it
+    (1e-9 relative: far below any printed digit, above float underflow: '> 0' is not '> 5e-324')."""
+    if integer:
+        assert not is_open and "." not in text, text
+        return int(text)
+    x = float(text)
+    if not is_open:
+        return x
+    step = 1e-9 * max(abs(x), 1.0)
+    return x + step if side == "lower" else x - step
+
+
+def keep_apex(data: dict) -> None:
+    """A differential body's housing lengths a, b moved with the gears and lengths they depend on
+    (the messages say 'change a_mm / b_mm with it'), in the model's own arithmetic."""
+    g, d = data["gears"], data["dimensions"]
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in
+               (g.get("module_mm"), g.get("big_teeth"), g.get("small_teeth"), d.get("l11_mm"), d.get("l12_mm"),
+                d.get("l2_mm"))):
+        return
+    d["b_mm"] = 2.0 * (d["l11_mm"] + d["l12_mm"] + g["module_mm"] * g["small_teeth"] / 2.0)
+    d["a_mm"] = 2.0 * (d["l2_mm"] + g["module_mm"] * g["big_teeth"] / 2.0)
+
+
+APEX_INPUTS = {"gears.module_mm", "gears.big_teeth", "gears.small_teeth", "dimensions.l11_mm", "dimensions.l12_mm",
+               "dimensions.l2_mm"}
+
+
+def _set(data: dict, field: str, value) -> None:
+    node = data
+    *parents, last = field.split(".")
+    for name in parents:
+        node = node[int(name)] if isinstance(node, list) else node[name]
+    if isinstance(node, list):
+        node[int(last)] = value
+    else:
+        node[last] = value
+
+
+def bounds_hold(mech_model, data: dict, exc: ParamError, source: str = "") -> int:
+    """Set the rejected field of ``data`` to each bound ``exc`` prints and validate again: accepted
+    or rejected on another field. Returns how many bounds were tried."""
+
+    bounds = printed_bounds(exc.allowed)
+    integer = isinstance(exc.value, int) and not isinstance(exc.value, bool)
+    for text, side, is_open in bounds:
+        trial = copy.deepcopy(data)
+        _set(trial, exc.field, bound_value(text, side, is_open, integer))
+        if exc.field in APEX_INPUTS:
+            keep_apex(trial)
+        try:
+            validate(mech_model, trial, source)
+        except ParamError as again:
+            assert again.field != exc.field, f"{exc}\n  at the printed {side} bound {text}: {again}"
+    return len(bounds)
+
+
+@pytest.mark.parametrize("name, overrides, field", [
+    (DIFF, ["gears.small_profile_shift=0.0"], "gears.small_profile_shift"),  # undercut: both ends
+    (DIFF, ["gears.small_profile_shift=0.8"], "gears.small_profile_shift"),  # pointed small gear
+    (DIFF, differential_set(big=10, small=10, shift=-0.6, pressure_deg=30), "gears.small_profile_shift"),  # big tip
+    (DIFF, ["gears.face_width_mm=20"], "gears.face_width_mm"),
+    (DIFF, ["dimensions.b_mm=70.0"], "dimensions.b_mm"),
+    (DIFF, ["dimensions.a_mm=93"], "dimensions.a_mm"),
+    (DIFF, ["dimensions.l12_mm=1.0", "dimensions.b_mm=59.5"], "dimensions.l12_mm"),
+    (DIFF, ["dimensions.l2_mm=0.2", "dimensions.a_mm=82.9"], "dimensions.l2_mm"),
+    (DIFF, differential_set(module_mm=1.5, face_width_mm=7.9), "gears.module_mm"),
+    (DIFF, differential_set(big=112, small=11, shift=0.3, pressure_deg=25), "gears.big_teeth"),
+    (TRACK, ["sprocket.seating_angle_deg=117"], "sprocket.seating_angle_deg"),
+    (TRACK, ["sprocket.seating_angle_deg=139"], "sprocket.seating_angle_deg"),
+    (TRACK, ["sprocket.seating_radius_mm=4.2"], "sprocket.seating_radius_mm"),
+    (TRACK, ["sprocket.flank_radius_mm=200"], "sprocket.flank_radius_mm"),
+    (TRACK, ["sprocket.tooth_width_mm=10.5"], "sprocket.tooth_width_mm"),
+    (TRACK, ["sprocket.tip_over_pitch_mm=13"], "sprocket.tip_over_pitch_mm"),
+    (TRACK, ["sprocket.middle_groove_width_mm=300"], "sprocket.middle_groove_width_mm"),
+    (TRACK, ["sprocket.tooth_width_mm=10", "chain.track_width_mm=19"], "sprocket.tooth_width_mm"),
+    (TRACK, ["chain.sleeve_diameter_mm=16"], "chain.sleeve_diameter_mm"),
+    (TRACK, ["track_plate.tip_gap_mm=4"], "track_plate.tip_gap_mm"),
+    (TRACK, ["chain.sleeve_diameter_mm=2.5", "chain.pin_diameter_mm=1", "sprocket.seating_radius_mm=1.3",
+             "sprocket.flank_radius_mm=30", "track_plate.tip_gap_mm=0.05"], "chain.sleeve_diameter_mm"),
+    (TRACK, ["chain.pitch_mm=10", "sprocket.teeth=17", "chain.sleeve_diameter_mm=3", "chain.pin_diameter_mm=1",
+             "sprocket.seating_radius_mm=1.6", "sprocket.flank_radius_mm=10", "sprocket.seating_angle_deg=125",
+             "sprocket.initial_pitch_diameter_mm=30", "sprocket.tooth_width_mm=10"], "sprocket.teeth"),
+    (TRACK, ["sprocket.teeth=13", "sprocket.flank_radius_mm=18"], "sprocket.teeth"),
+    (STEER, ["pinion.teeth=16", "pinion.pressure_angle_deg=20"], "pinion.teeth"),
+    (STEER, ["pinion.profile_shift=1.0", "pinion.addendum_coefficient=1.5", "rack.dedendum_coefficient=2"],
+     "pinion.addendum_coefficient"),
+    (STEER, ["rack.addendum_coefficient=1.45", "pinion.dedendum_coefficient=1.6"], "rack.addendum_coefficient"),
+    (STEER, ["pinion.addendum_coefficient=0.5", "rack.addendum_coefficient=0.5", "pinion.pressure_angle_deg=25",
+             "pinion.dedendum_coefficient=1.0", "rack.dedendum_coefficient=1.0"], "rack.addendum_coefficient"),
+    (STEER, ["pinion.addendum_coefficient=0.5", "rack.addendum_coefficient=0.5", "pinion.pressure_angle_deg=20",
+             "pinion.dedendum_coefficient=1.0", "rack.dedendum_coefficient=1.0"], "rack.addendum_coefficient"),
+    (STEER, ["trim.hS4_mm=24.0"], "trim.hS4_mm"),
+    (STEER, ["trim.hS2_mm=28"], "trim.hS2_mm"),
+    (STEER, ["trim.hS8_mm=26.9"], "trim.hS8_mm"),
+    (STEER, ["trim.hS6_mm=26.5"], "trim.hS6_mm"),
+    (STEER, ["trim.min_contact_ratio=3"], "trim.min_contact_ratio"),
+    (STEER, ["pinion.topped_radius_mm=90"], "pinion.topped_radius_mm"),
+    (STEER, ["layout.centre_to_datum_mm=80"], "layout.centre_to_datum_mm"),
+    (STEER, ["pinion.module_mm=1"], "pinion.teeth"),
+    (STEER, ["pinion.module_mm=0.1"], "pinion.module_mm"),
+    (STEER, ["pinion.dedendum_coefficient=1.8"], "pinion.dedendum_coefficient"),
+    (STEER, ["rack.dedendum_coefficient=1.8"], "rack.dedendum_coefficient"),
+])
+def test_printed_bounds_are_accepted(templates_dir, name, overrides, field):
+    exc = rejected(templates_dir, name, *overrides)
+    assert exc.field == field, str(exc)
+    data = apply_overrides(read_toml(templates_dir / name), overrides)
+    model = mechanism(data.pop("mechanism")).Params
+    assert bounds_hold(model, data, exc) >= 1, str(exc)
+
+
+def test_seating_angle_bound_of_the_report(templates_dir):
+    """The reported case: 120° − 90°/49 = 118.1633° once printed as 118.16, which was rejected."""
+    exc = assert_rejects(templates_dir, TRACK, ["sprocket.seating_angle_deg=117"], "sprocket.seating_angle_deg",
+                         "allowed 118.17 to 138.16°")
+    load_template(templates_dir / TRACK, ["sprocket.seating_angle_deg=118.17"])
+    load_template(templates_dir / TRACK, ["sprocket.seating_angle_deg=138.16"])
+    with pytest.raises(ParamError):
+        load_template(templates_dir / TRACK, ["sprocket.seating_angle_deg=118.16"])
+    assert exc.value == 117.0
+
+
+def test_fmt_bound_rounds_inward():
+    assert fmt_bound(120 - 90 / 49, "lower", 2) == "118.17"
+    assert fmt_bound(140 - 90 / 49, "upper", 2) == "138.16"
+    assert fmt_bound(0.505 * 8, "lower") == fmt_bound(0.505 * 8, "upper") == "4.040"  # on the grid: as it is
+    assert fmt_bound(-1e-4, "lower") == "0.000"  # no '-0.000'
+    assert fmt_bound(-1e-4, "upper") == "-0.001"
+    assert fmt_bound(8.5, "upper", None) == "8.5" and fmt_bound(0.1 + 0.2, "lower", None) == repr(0.1 + 0.2)
+    # ok: the rule's own test moves the bound inward
+    assert fmt_bound(1.2344, "upper", ok=lambda v: v <= 1.2335) == "1.233"
+    assert fmt_bound(1.2344, "upper", ok=lambda v: v < 1.234, strict=True) == "1.234"
+    # a range narrower than the printed unit gets more digits, ends still in order
+    assert fmt_range(0.1231, 0.1236) == "0.1231 to 0.1236"
+    assert fmt_range(1.0, 2.0, lo_open=True) == ">1.000 to 2.000"
+    for x in (0.1, 1 / 3, 2.675, 118.16326530612245, -7.0005, 1e-7):
+        for digits in (0, 1, 2, 3, 5):
+            assert float(fmt_bound(x, "lower", digits)) >= x
+            assert float(fmt_bound(x, "upper", digits)) <= x
+
+
+# ---------------------------------------------------------- the same over random sets
+BOUNDS = settings(derandomize=True, deadline=None, database=None,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+
+
+def _random_bounds_hold(mech: str, data) -> None:
+    body = draw_set(mech, data)
+    model = mechanism(mech).Params
+    try:
+        validate(model, body, "fuzz.toml")
+    except ParamError as exc:
+        # computed bounds only: a field's own Field(ge, le) range is printed exactly (field_range)
+        # and knows no cross-field rule
+        own_range = exc.allowed.startswith(("out of range", "wrong type", "must be a finite number"))
+        if exc.field and not isinstance(exc.value, dict) and not own_range:
+            bounds_hold(model, body, exc, "fuzz.toml")
+
+
+@settings(BOUNDS, max_examples=300)
+@given(data=st.data())
+def test_printed_bounds_hold_on_random_differential_sets(data):
+    _random_bounds_hold("differential", data)
+
+
+@settings(BOUNDS, max_examples=300)
+@given(data=st.data())
+def test_printed_bounds_hold_on_random_track_sets(data):
+    _random_bounds_hold("track", data)
+
+
+@settings(BOUNDS, max_examples=300)
+@given(data=st.data())
+def test_printed_bounds_hold_on_random_steering_sets(data):
+    _random_bounds_hold("steering", data)

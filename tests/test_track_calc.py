@@ -199,7 +199,7 @@ def test_crush_fails_with_a_low_allowable(template):
         ("chain.sleeve_diameter_mm=15", "chain.sleeve_diameter_mm", "allowed < 14.882 mm"),
         ("sprocket.seating_radius_mm=4.2", "sprocket.seating_radius_mm", "allowed 4.040 to 4.178 mm"),
         ("sprocket.flank_radius_mm=200", "sprocket.flank_radius_mm", "allowed 48.96 to 165.18 mm"),
-        ("sprocket.seating_angle_deg=117", "sprocket.seating_angle_deg", "allowed 118.16 to 138.16°"),
+        ("sprocket.seating_angle_deg=117", "sprocket.seating_angle_deg", "allowed 118.17 to 138.16°"),
         ("sprocket.tooth_width_mm=10.5", "sprocket.tooth_width_mm", "allowed <= 10.260 mm"),
         ("sprocket.nonsense=1", "sprocket.nonsense", "unknown key"),
         ('chain.pitch_mm="30 mm"', "chain.pitch_mm", "wrong type"),

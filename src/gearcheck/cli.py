@@ -1,29 +1,58 @@
-"""Command line: parse, call the pipeline, print. Exit codes: 0 ok, 1 a verdict failed, 2 bad input.
+"""Command line: parse, call the pipeline, print. Exit codes: 0 ok, 1 a verdict failed, 2 bad
+input (or an output that cannot be written), 130 / 143 interrupted by SIGINT / SIGTERM.
 
 The only module that prints. Everything it runs is the library's (:mod:`gearcheck.design`,
 :mod:`gearcheck.pipeline`); progress bars go to stderr when it is a terminal, diagnostics to the
 ``gearcheck`` logger (``-v`` shows them).
+
+Interrupts: SIGINT and SIGTERM are caught from the first lines of this module on (its imports are
+the standard library's only; the rest is imported inside :func:`main`), so an interrupt at any
+moment unwinds through the run's transaction — its staging folder removed, the output folder as
+it was, worker processes stopped — and ends in one line and exit 130 / 143.
 """
 
 from __future__ import annotations
 
-import argparse
-import contextlib
-import json
-import logging
+import signal
 import sys
-from collections.abc import Iterator
-from pathlib import Path
-from typing import TYPE_CHECKING, Any
 
-from gearcheck import __version__
-from gearcheck.params import ParamError
+
+class Interrupted(BaseException):
+    """SIGINT or SIGTERM arrived: unwind (transactions clean up), then exit 128 + signal."""
+
+    def __init__(self, signum: int):
+        super().__init__(signum)
+        self.signum = signum
+
+
+_received: list[int] = []
+
+
+def _on_signal(signum: int, _frame: object) -> None:
+    if _received:  # already unwinding: let the cleanup finish
+        return
+    _received.append(signum)
+    raise Interrupted(signum)
+
+
+if "--multiprocessing-fork" not in sys.argv:  # not in a sweep worker (its executor sets its own)
+    signal.signal(signal.SIGINT, _on_signal)
+    signal.signal(signal.SIGTERM, _on_signal)
+
+import argparse  # noqa: E402  (after the handlers: an interrupt during start-up is one line too)
+import contextlib  # noqa: E402
+import json  # noqa: E402
+import logging  # noqa: E402
+import os  # noqa: E402
+from collections.abc import Iterator  # noqa: E402
+from pathlib import Path  # noqa: E402
+from typing import TYPE_CHECKING, Any  # noqa: E402
+
+from gearcheck import __version__  # noqa: E402
 
 if TYPE_CHECKING:
     from gearcheck.design import Design
     from gearcheck.pipeline import Bar
-
-TEMPLATE_DIR = Path("templates")
 
 DESCRIPTION = """\
 gearcheck turns a parameter file (TOML template) into the design figures, CAD and an
@@ -96,7 +125,11 @@ def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
     p.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one template value (repeatable)")
-    p.add_argument("--all", action="store_true", help=f"{verb} every template in templates/ into OUT/NAME")
+    p.add_argument("--all", action="store_true",
+                   help=f"{verb} every template into OUT/NAME (those in --templates, else ./templates/, "
+                        "else the ones shipped with gearcheck)")
+    p.add_argument("--templates", type=Path, default=None, metavar="DIR",
+                   help="folder of templates for --all (default: ./templates/ if it holds any, else the shipped ones)")
     p.add_argument("--out", type=Path, default=None,
                    help="output folder (default out/NAME; with --all, the parent folder, default out)")
     p.add_argument("--tol", type=float, default=None, metavar="MM", help=TOL_HELP)
@@ -149,9 +182,18 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", formatter_class=_Formatter,
                           help="every template in templates/: figures and CAD under --out (what `make demo` runs)")
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
-    demo.add_argument("--templates", type=Path, default=TEMPLATE_DIR, help="folder of templates (default: templates)")
+    demo.add_argument("--templates", type=Path, default=None, metavar="DIR",
+                      help="folder of templates (default: ./templates/ if it holds any, else the shipped ones)")
     demo.add_argument("--no-cad", action="store_true", help="analytical figures only, no CAD build")
     _add_jobs_arg(demo, "the sweeps")
+
+    templates = sub.add_parser("templates", formatter_class=_Formatter,
+                               help="list the templates shipped with gearcheck, or copy them to a folder",
+                               description="List the templates shipped with gearcheck (file, mechanism, what it "
+                               "models), or copy them into DIR to edit: `gearcheck templates --copy my_designs`.")
+    templates.add_argument("--copy", type=Path, default=None, metavar="DIR",
+                           help="copy the shipped templates into DIR (created; an existing different file is "
+                                "not overwritten)")
     return parser
 
 
@@ -197,15 +239,22 @@ def cmd_calc(args) -> int:
 
 def _templates_or_one(args) -> list[Design]:
     """The validated templates a build/check acts on: one, or --all (all validated first)."""
-    from gearcheck.design import load_template
+    from gearcheck.design import find_templates, load_template
+    from gearcheck.params import ParamError
     from gearcheck.pipeline import check_tol
 
     check_tol(args.tol)
     if args.all == (args.template is not None):
         raise ParamError(args.command, str(args.template), "give one TEMPLATE or --all, not both or neither")
-    if args.all:
-        return [load_template(t, args.overrides) for t in sorted(TEMPLATE_DIR.glob("*.toml"))]
-    return [load_template(args.template, args.overrides)]
+    if not args.all:
+        return [load_template(args.template, args.overrides)]
+    _, paths = find_templates(args.templates)
+    designs = [load_template(t, args.overrides) for t in paths]
+    names = [d.name for d in designs]
+    if len(set(names)) != len(names):
+        raise ParamError("--set", " ".join(args.overrides) or "name", "allowed only when every template keeps "
+                         f"its own result name (--all would write {len(names)} runs into {sorted(set(names))})")
+    return designs
 
 
 def _out_folder(args, design: Design) -> Path:
@@ -215,17 +264,23 @@ def _out_folder(args, design: Design) -> Path:
 
 
 def _prepared_folders(args, designs: list[Design]) -> list[Path]:
-    """Every output folder checked (created, writable) before any CAD work starts."""
-    from gearcheck.output import ensure_out_dir
+    """Every output folder's name and parent checked (the parent created, writable) before any
+    CAD work starts; each folder itself is written as one transaction later."""
+    from gearcheck.output import check_out_target
 
-    return [ensure_out_dir(_out_folder(args, d)) for d in designs]
+    folders = [_out_folder(args, d) for d in designs]
+    for folder in folders:
+        check_out_target(folder)
+    return folders
 
 
-def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | None) -> bool:
+def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | None,
+               overrides: list[str] | tuple = (), extra_files: dict | None = None) -> bool:
     from gearcheck import pipeline
 
     print(f"building {design.name} ({design.mechanism}) ...", file=sys.stderr)
-    run = pipeline.check(design, folder, tol_mm=tol_mm, jobs=jobs, progress=_bars)
+    run = pipeline.check(design, folder, tol_mm=tol_mm, jobs=jobs, progress=_bars, overrides=overrides,
+                         extra_files=extra_files)
     print(f"wrote {folder}/ : {len(run.build.parts)} parts, {run.build.manifest['step']['file']}, manifest.json")
     _print_verdicts(design, folder, run.result)
     return run.passed
@@ -234,15 +289,17 @@ def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | N
 def cmd_check(args) -> int:
     designs = _templates_or_one(args)
     folders = _prepared_folders(args, designs)
-    passed = [_check_one(d, folder, args.tol, args.jobs) for d, folder in zip(designs, folders, strict=True)]
+    passed = [_check_one(d, folder, args.tol, args.jobs, args.overrides)
+              for d, folder in zip(designs, folders, strict=True)]
     return 0 if all(passed) else 1
 
 
-def _build_task(_state: Any, design: Design, folder: Path, tol_mm: float | None) -> tuple[int, str]:
+def _build_task(_state: Any, design: Design, folder: Path, tol_mm: float | None,
+                overrides: list[str]) -> tuple[int, str]:
     """One template's build (module-level: --all --jobs N builds templates in worker processes)."""
     from gearcheck import pipeline
 
-    run = pipeline.build(design, folder, tol_mm=tol_mm)
+    run = pipeline.build(design, folder, tol_mm=tol_mm, overrides=overrides)
     return len(run.parts), run.manifest["step"]["file"]
 
 
@@ -253,14 +310,14 @@ def cmd_build(args) -> int:
     folders = _prepared_folders(args, designs)
     executor = make_executor(args.jobs)
     if executor.jobs > 1 and len(designs) > 1:
-        tasks = [(d, f, args.tol) for d, f in zip(designs, folders, strict=True)]
+        tasks = [(d, f, args.tol, args.overrides) for d, f in zip(designs, folders, strict=True)]
         with _bars("building", len(tasks), "template") as bar:
             built = executor.map(_build_task, tasks, progress=bar.update)
     else:
         built = []
         for d, f in zip(designs, folders, strict=True):
             print(f"building {d.name} ({d.mechanism}) ...", file=sys.stderr)
-            built.append(_build_task(None, d, f, args.tol))
+            built.append(_build_task(None, d, f, args.tol, args.overrides))
     for (n_parts, step), folder in zip(built, folders, strict=True):
         print(f"wrote {folder}/ : {n_parts} parts, {step}, manifest.json")
     return 0
@@ -269,45 +326,118 @@ def cmd_build(args) -> int:
 def cmd_demo(args) -> int:
     """Every template: the analytical figures (calc.json, calc.txt), then `check` (CAD, sweep,
     report) unless --no-cad. Exit 1 if any verdict fails, after every template has run."""
-    from gearcheck.design import load_template
+    from gearcheck import pipeline
+    from gearcheck.design import find_templates, load_template
     from gearcheck.figures import render_table
-    from gearcheck.output import atomic_write_text, ensure_out_dir
+    from gearcheck.output import check_out_target, ensure_out_dir
 
-    templates = sorted(args.templates.glob("*.toml"))
-    if not templates:
-        raise ParamError("--templates", str(args.templates), "no *.toml templates found there")
+    _, templates = find_templates(args.templates)
     designs = [load_template(path) for path in templates]  # validate every template first
-    folders = [ensure_out_dir(args.out / d.name) for d in designs]
+    ensure_out_dir(args.out)
+    folders = [args.out / d.name for d in designs]
+    for folder in folders:
+        check_out_target(folder)
     passed = []
     for design, folder in zip(designs, folders, strict=True):
         calc = design.calc()
-        atomic_write_text(folder / "calc.json", json.dumps(calc.to_dict(), indent=2, allow_nan=False) + "\n")
         table = render_table(f"{design.name} ({design.mechanism}) — analytical model", calc.figures)
-        atomic_write_text(folder / "calc.txt", table + "\n")
+        files = {"calc.json": json.dumps(calc.to_dict(), indent=2, allow_nan=False) + "\n", "calc.txt": table + "\n"}
         print(table)
         print()
-        if not args.no_cad:
-            passed.append(_check_one(design, folder, None, args.jobs))
+        if args.no_cad:
+            pipeline.write_files(design, folder, files)
+        else:
+            passed.append(_check_one(design, folder, None, args.jobs, extra_files=files))
             print()
     print(f"wrote {len(designs)} result folders under {args.out}/ (open NAME/report.html)")
     return 0 if all(passed) else 1
 
 
-COMMANDS = {"calc": cmd_calc, "build": cmd_build, "check": cmd_check, "demo": cmd_demo}
+def cmd_templates(args) -> int:
+    """List the shipped templates, or copy them into --copy DIR."""
+    import shutil
+
+    from gearcheck.design import load_template, packaged_templates
+    from gearcheck.output import OutputError, ensure_out_dir
+
+    shipped = sorted(packaged_templates().glob("*.toml"))
+    if args.copy is None:
+        for path in shipped:
+            design = load_template(path)
+            print(f"{path.name:32s} {design.mechanism:13s} {design.impl.title}")
+        print(f"({len(shipped)} templates in {packaged_templates()}; copy them with --copy DIR)")
+        return 0
+    folder = ensure_out_dir(args.copy)
+    for path in shipped:
+        target = folder / path.name
+        if target.exists() and target.read_bytes() != path.read_bytes():
+            raise OutputError(target, "exists and differs from the shipped template (not overwritten)")
+        shutil.copyfile(path, target)
+    print(f"copied {len(shipped)} templates to {folder}/")
+    return 0
+
+
+COMMANDS = {"calc": cmd_calc, "build": cmd_build, "check": cmd_check, "demo": cmd_demo, "templates": cmd_templates}
+
+
+def _error(text: str) -> int:
+    print(f"gearcheck: error: {text}", file=sys.stderr)
+    return 2
+
+
+def _interrupted(signum: int) -> int:
+    """One line, exit 128 + signal: what the run folder holds now."""
+    from gearcheck.output import RunFolder
+
+    where = RunFolder.abandoned
+    what = f"{where} unchanged" if where else "nothing written"
+    with contextlib.suppress(OSError):
+        sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(signum).name}): {what}\n")
+        sys.stderr.flush()
+    return 128 + signum
+
+
+def _quiet_stdout() -> None:
+    """After a failed write to stdout: point it at /dev/null, so the interpreter's last flush
+    does not fail again with a second message."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
 
 
 def main(argv: list[str] | None = None) -> int:
+    try:
+        return _main(argv)
+    except Interrupted as exc:
+        return _interrupted(exc.signum)
+    except BaseException:
+        if _received:  # an interrupt surfaced as another error (e.g. inside an extension's import)
+            return _interrupted(_received[0])
+        raise
+
+
+def _main(argv: list[str] | None) -> int:
+    for stream in (sys.stdout, sys.stderr):  # a terminal that cannot show "α" gets "\u03b1", not a crash
+        with contextlib.suppress(AttributeError, ValueError):
+            stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="gearcheck: %(message)s", stream=sys.stderr)
+    from gearcheck.output import output_error
+    from gearcheck.params import ParamError
+
     try:
-        return COMMANDS[args.command](args)
+        code = COMMANDS[args.command](args)
+        sys.stdout.flush()
+        return code
     except ParamError as exc:
-        print(f"gearcheck: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        return 0
+        return _error(str(exc))
+    except OSError as exc:  # an output nobody could write: stdout closed or full, a path too long
+        if exc.filename is None:  # no file named: the write that failed was to stdout
+            _quiet_stdout()
+            return _error(str(output_error(exc, "<stdout>")))
+        return _error(str(output_error(exc, verb="access")))
 
 
 if __name__ == "__main__":

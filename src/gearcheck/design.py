@@ -24,8 +24,15 @@ if TYPE_CHECKING:
     from gearcheck.figures import Figure
     from gearcheck.pipeline import BuildRun, CheckRun
 
-# An optional top-level `name` names the result files; it must be a plain folder name.
+# An optional top-level `name` names the result files (else the file's stem does); either must be
+# a plain folder name: no separators, no "..", no spaces or control characters.
 NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
+NAME_RULE = "allowed 1 to 64 characters of A-Z a-z 0-9 _ . - starting with a letter, digit or _ (a folder name)"
+# The meshing tolerances a run may use (mm): --tol, or a template's top-level mesh_tol_mm.
+TOL_MIN_MM = 0.0005
+TOL_MAX_MM = 0.5
+# Top-level keys that are not sections of the mechanism's parameters.
+RUN_KEYS = ("mechanism", "name", "mesh_tol_mm")
 
 
 @dataclass(frozen=True)
@@ -72,12 +79,12 @@ class Design:
         rerun from ``out/NAME/params.toml`` keeps NAME), else the mechanism's name."""
         if self.data.get("name"):
             return str(self.data["name"])
-        return self.path.stem if self.path is not None else self.mechanism
+        return _stem(self.path) if self.path is not None else self.mechanism
 
     @property
     def resolved_data(self) -> dict:
         """The resolved parameters with the result name recorded, as written to params.toml."""
-        rest = {k: v for k, v in self.data.items() if k not in ("mechanism", "name")}
+        rest = {k: v for k, v in self.data.items() if k not in RUN_KEYS}
         return {"mechanism": self.mechanism, "name": self.name, **rest}
 
     def default_tol_mm(self) -> float:
@@ -111,10 +118,26 @@ class Design:
         return cad_assembly(impl.parts(impl.assembly(self.params)), self.name)
 
 
-def _check_name(data: dict, source: str) -> None:
+def _stem(path: Path) -> str:
+    """The file name without its last suffix ("my.drive.toml" → "my.drive"; "...toml" → "..")."""
+    name = path.name
+    return name[: -len(path.suffix)] if path.suffix else name
+
+
+def _check_run_keys(data: dict, path: Path | None, source: str) -> None:
+    """The result name (top-level ``name``, else the file's stem) is a safe folder name, and a
+    recorded ``mesh_tol_mm`` is a tolerance a run may use."""
     name = data.get("name")
-    if name is not None and not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)):
-        raise ParamError("name", name, "allowed 1 to 64 characters of A-Z a-z 0-9 _ . - (a folder name)", source)
+    if name is not None:
+        if not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)):
+            raise ParamError("name", name, NAME_RULE, source)
+    elif path is not None and not NAME_PATTERN.fullmatch(_stem(path)):
+        raise ParamError("name", _stem(path), f"{NAME_RULE}; the file's name names the result unless the "
+                         "template sets a top-level name = \"...\"", source)
+    tol = data.get("mesh_tol_mm")
+    if tol is not None and (isinstance(tol, bool) or not isinstance(tol, (int, float))
+                            or not TOL_MIN_MM <= tol <= TOL_MAX_MM):
+        raise ParamError("mesh_tol_mm", tol, f"out of range: allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm", source)
 
 
 def from_data(data: dict, path: Path | None = None) -> Design:
@@ -125,8 +148,8 @@ def from_data(data: dict, path: Path | None = None) -> Design:
     if not isinstance(mech, str) or mech not in known:
         raise ParamError("mechanism", mech if mech is not None else MISSING,
                          f"allowed one of: {', '.join(known)}", source)
-    _check_name(data, source)
-    body = {k: v for k, v in data.items() if k not in ("mechanism", "name")}
+    _check_run_keys(data, path, source)
+    body = {k: v for k, v in data.items() if k not in RUN_KEYS}
     params = validate(registry.get(mech).Params, body, source)
     return Design(path=path, mechanism=mech, params=params, data=data)
 
@@ -162,3 +185,26 @@ def load(template: str | Path | Mapping[str, Any],
 def load_template(path: str | Path, overrides: list[str] | None = None) -> Design:
     """A template file with ``--set`` overrides (the CLI's form of :func:`load`)."""
     return load(Path(path), overrides or [])
+
+
+def packaged_templates() -> Path:
+    """The folder of the templates shipped in the package."""
+    from importlib.resources import files
+
+    return Path(str(files("gearcheck") / "templates"))
+
+
+def find_templates(folder: Path | None = None) -> tuple[Path, list[Path]]:
+    """The templates ``--all`` and ``demo`` run: those in ``folder`` when given, else in
+    ./templates when it holds any, else the packaged ones. A given folder without templates is
+    bad input: running nothing must never look like a pass."""
+    if folder is not None:
+        found = sorted(Path(folder).glob("*.toml")) if Path(folder).is_dir() else []
+        if not found:
+            raise ParamError("--templates", str(folder), "allowed a folder holding *.toml templates (none found there)")
+        return Path(folder), found
+    local = Path("templates")
+    if local.is_dir() and (found := sorted(local.glob("*.toml"))):
+        return local, found
+    shipped = packaged_templates()
+    return shipped, sorted(shipped.glob("*.toml"))

@@ -12,9 +12,14 @@ python-fcl for a sweep), never CadQuery (~2 s and ~420 MB each).
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import logging
 import multiprocessing as mp
 import os
+import signal
+import sys
+import threading
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
@@ -63,9 +68,64 @@ class SerialExecutor:
 _worker_state: Any = None
 
 
+def _quiet_worker() -> None:
+    """A worker leaves interrupts to its parent (which stops the pool) and dies with it: SIGINT
+    ignored, SIGTERM the default (a silent exit), and on Linux a SIGKILL when the parent dies,
+    so a killed run leaves no process and no traceback behind."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})  # blocked by the parent while spawning
+    with contextlib.suppress(OSError, AttributeError):
+        pr_set_pdeathsig = 1
+        ctypes.CDLL(None, use_errno=True).prctl(pr_set_pdeathsig, int(signal.SIGKILL))
+    if os.getppid() == 1:  # the parent died before we got here
+        os._exit(0)
+
+
 def _init_worker(setup, shared) -> None:
     global _worker_state  # noqa: PLW0603 - one state per worker process, made once
+    _quiet_worker()
     _worker_state = setup(shared) if setup is not None else shared
+
+
+class _Spawning:
+    """While workers are spawned: SIGINT blocked in this thread, so the children inherit it
+    blocked (a Ctrl-C in the terminal — sent to the whole process group — reaches only the
+    parent, which stops the pool); and SIGINT / SIGTERM that reach the process meanwhile (other
+    threads, e.g. the CAD kernel's, do not block them) are only recorded, then raised again
+    once the pool exists and can be stopped cleanly. No-op outside the main thread of the main
+    process (signals are not ours to change there)."""
+
+    def __init__(self) -> None:
+        self.active = mp.parent_process() is None and threading.current_thread() is threading.main_thread()
+        self.pending: list[int] = []
+        self._handlers: dict[int, Any] = {}
+        self._mask: Any = None
+
+    def _record(self, signum: int, _frame: object) -> None:
+        self.pending.append(signum)
+
+    def __enter__(self) -> _Spawning:
+        if self.active:
+            # multiprocessing's resource tracker warns about "leaked semaphores" when a killed
+            # parent could not close its pool: nothing leaks that the kernel does not reclaim
+            quiet = "ignore::UserWarning:multiprocessing.resource_tracker"
+            if quiet not in sys.warnoptions:
+                sys.warnoptions.append(quiet)
+            self._handlers = {s: signal.signal(s, self._record) for s in (signal.SIGINT, signal.SIGTERM)}
+            self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self.active:
+            for s, handler in self._handlers.items():
+                signal.signal(s, handler if handler is not None else signal.SIG_DFL)
+            signal.pthread_sigmask(signal.SIG_SETMASK, self._mask)
+
+    def deliver(self) -> None:
+        """Raise the signals recorded while spawning (handled by the restored handlers)."""
+        for s in dict.fromkeys(self.pending):
+            signal.raise_signal(s)
 
 
 def _run(job: tuple) -> Any:
@@ -89,7 +149,10 @@ class ProcessExecutor:
         log.debug("running %d tasks on %d processes", len(tasks), workers)
         ctx = mp.get_context("spawn")
         chunk = max(1, len(tasks) // (8 * workers))
-        with ctx.Pool(workers, initializer=_init_worker, initargs=(setup, shared)) as pool:
+        with _Spawning() as spawning:
+            pool = ctx.Pool(workers, initializer=_init_worker, initargs=(setup, shared))
+        with pool:  # leaving the block (an error, an interrupt) terminates the workers
+            spawning.deliver()
             out = []
             for i, result in enumerate(pool.imap(_run, [(fn, tuple(a)) for a in tasks], chunksize=chunk)):
                 out.append(result)

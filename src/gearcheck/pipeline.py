@@ -14,11 +14,12 @@ import contextlib
 import json
 import logging
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
+from gearcheck.design import TOL_MAX_MM, TOL_MIN_MM
 from gearcheck.params import ParamError
 from gearcheck.results import CheckResult, Confirmation
 
@@ -32,9 +33,6 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("gearcheck")
 
-# --tol: the meshing tolerances a user may ask for (mm).
-TOL_MIN_MM = 0.0005
-TOL_MAX_MM = 0.5
 REPORT_FILES = ("summary.json", "sweep.csv", "report.html")
 
 
@@ -62,8 +60,30 @@ def check_tol(tol_mm: float | None) -> None:
 
 
 def mesh_tol(design: Design, tol_mm: float | None) -> float:
-    """--tol, or the mechanism's default (fine enough for the template's smallest clearance)."""
-    return tol_mm if tol_mm is not None else design.impl.mesh_tol_mm
+    """--tol, else the template's ``mesh_tol_mm`` (a params.toml records the tolerance its run
+    used), else the mechanism's default (fine enough for the template's smallest clearance)."""
+    if tol_mm is not None:
+        return tol_mm
+    recorded = design.data.get("mesh_tol_mm")
+    return float(recorded) if recorded is not None else design.impl.mesh_tol_mm
+
+
+def run_params(design: Design, tol_mm: float) -> dict:
+    """What params.toml records: the resolved parameters, the result name and the mesh
+    tolerance, so ``gearcheck check out/NAME/params.toml`` reproduces the run."""
+    data = design.resolved_data
+    return {"mechanism": data["mechanism"], "name": data["name"], "mesh_tol_mm": tol_mm,
+            **{k: v for k, v in data.items() if k not in ("mechanism", "name", "mesh_tol_mm")}}
+
+
+def provenance(design: Design, overrides: Sequence[str] = ()) -> str:
+    """The comment heading params.toml: where the parameters came from."""
+    from gearcheck import __version__
+
+    text = f"gearcheck {__version__} run {design.name}: the resolved parameters of {design.source}"
+    if overrides:
+        text += " with " + " ".join(f"--set {o}" for o in overrides)
+    return text + ". Re-run: gearcheck check params.toml"
 
 
 # ------------------------------------------------------------------------------------------
@@ -83,7 +103,7 @@ class BuildRun:
     exported: list[ExportedPart]
     bodies: dict[str, Body]
     manifest: dict
-    files: list[Path] = field(default_factory=list)
+    files: list[Path] = field(default_factory=list)  # every file of the run (after the swap)
 
 
 def build_parts(design: Design) -> tuple[Assembly, list[Part]]:
@@ -111,25 +131,75 @@ def sweep_bodies(exported: list[ExportedPart]) -> dict[str, Body]:
     }
 
 
-def build(design: Design, folder: Path, *, tol_mm: float | None = None,
-          progress: ProgressFactory = no_progress) -> BuildRun:
-    """Build the CAD, mesh each part at ``tol_mm`` (default: the mechanism's), and write
-    NAME.step, PART.stl, params.toml and manifest.json into ``folder`` (each atomically)."""
+def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: ProgressFactory,
+                overrides: Sequence[str] = ()) -> BuildRun:
+    """Solids, meshes, STEP/STL/params.toml/manifest.json written into ``folder`` (a staging
+    folder: the caller commits it)."""
     from gearcheck.cad.export import export_parts
-    from gearcheck.output import ensure_out_dir
 
-    check_tol(tol_mm)
-    folder = ensure_out_dir(folder).absolute()  # the files stay findable after a chdir
     tol = mesh_tol(design, tol_mm)
-    log.debug("building %s (%s)", design.name, design.mechanism)
+    check_tol(tol)
+    log.info("stage build: %s (%s), solids", design.name, design.mechanism)
     assembly, parts = build_parts(design)
+    log.info("stage mesh: %s, %d parts at %g mm", design.name, len(parts), tol)
     with progress(f"meshing {design.name}", len(parts), "part") as bar:
         manifest, exported = export_parts(parts, folder, name=design.name, mechanism=design.mechanism,
-                                          params_data=design.resolved_data, tol_mm=tol,
-                                          progress=lambda _name: bar.update(1))
-    files = [folder / manifest["step"]["file"], *(folder / p["stl"]["file"] for p in manifest["parts"]),
-             folder / manifest["params_file"]["file"], folder / "manifest.json"]
-    return BuildRun(design, folder, tol, assembly, parts, exported, sweep_bodies(exported), manifest, files)
+                                          params_data=run_params(design, tol), tol_mm=tol,
+                                          progress=lambda _name: bar.update(1),
+                                          params_comment=provenance(design, overrides))
+    return BuildRun(design, folder, tol, assembly, parts, exported, sweep_bodies(exported), manifest)
+
+
+def _seal(folder: Path, manifest: dict, extra: Mapping[str, str] | None, shown: Path) -> dict:
+    """Write the extra files, list every file of the run (size and sha256) in the manifest,
+    rewrite it, and verify the folder against it before it may be swapped in. A file that does
+    not read back as written (cut short by a file-size limit or a full disk the writer did not
+    report) is a write failure of that file, named as it would be in ``shown``."""
+    from gearcheck.output import OutputError, atomic_write_text
+    from gearcheck.verify import RunIncomplete, listing, verify_run
+
+    for name, text in (extra or {}).items():
+        atomic_write_text(folder / name, text)
+    manifest = {**manifest, "files": listing(folder)}
+    atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
+    try:
+        return verify_run(folder)
+    except RunIncomplete as exc:
+        raise OutputError(shown / exc.file if exc.file else shown, f"cannot write: {exc}") from None
+
+
+def write_files(design: Design, folder: Path, files: Mapping[str, str]) -> Path:
+    """A run folder holding only the given text files (``demo --no-cad``: the analytical
+    figures), written as one transaction like every run."""
+    from gearcheck import __version__
+    from gearcheck.output import RunFolder
+
+    with RunFolder(folder) as txn:
+        manifest = {"gearcheck_version": __version__, "mechanism": design.mechanism, "name": design.name}
+        _seal(txn.staging, manifest, files, Path(folder))
+        return txn.commit()
+
+
+def _rooted(run: BuildRun, target: Path, files: list[str]) -> None:
+    run.folder = target
+    run.files = [target / n for n in files]
+
+
+def build(design: Design, folder: Path, *, tol_mm: float | None = None,
+          progress: ProgressFactory = no_progress, overrides: Sequence[str] = (),
+          extra_files: Mapping[str, str] | None = None) -> BuildRun:
+    """Build the CAD, mesh each part at ``tol_mm`` (default: the template's, else the
+    mechanism's), and write NAME.step, PART.stl, params.toml and manifest.json as one
+    transaction: staged beside ``folder``, verified, swapped in (:class:`gearcheck.output.RunFolder`)."""
+    from gearcheck.output import RunFolder
+
+    check_tol(tol_mm)
+    with RunFolder(folder) as txn:
+        run = _build_into(design, txn.staging, tol_mm, progress, overrides)
+        run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
+        target = txn.commit()
+    _rooted(run, target, ["manifest.json", *run.manifest["files"]])
+    return run
 
 
 # ------------------------------------------------------------------------------------------
@@ -149,6 +219,7 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     check_poses(assembly, bodies)
     executor = executor if executor is not None else make_executor(jobs)
     plan = impl.plan(design.params, assembly, bodies, options)
+    log.info("stage sweep: %s, %d tasks on %d worker(s)", design.name, len(plan.tasks), executor.jobs)
     t0 = time.perf_counter()
     with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar:
         results = executor.map(run_task, plan.tasks, setup=make_scene, shared=plan.meshes,
@@ -196,6 +267,7 @@ def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
     from gearcheck.sweep.tools import mesh_nearest_midpoint
 
     by_name = {p.name: p for p in parts}
+    log.info("stage confirm: %d worst poses on the exact B-rep", len(result.worst_poses))
     out = []
     with progress("exact B-rep distance at worst poses", len(result.worst_poses), "pose") as bar:
         for worst in result.worst_poses:
@@ -234,11 +306,13 @@ class CheckRun:
 
 
 def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict) -> tuple[list[Path], dict]:
-    """summary.json, sweep.csv and report.html (each atomically); the files and summary.json's data."""
+    """summary.json, sweep.csv and report.html (each atomically, in the run's staging folder);
+    the files and summary.json's data."""
     from gearcheck.output import atomic_write_text
     from gearcheck.report.files import summary_json, sweep_csv
     from gearcheck.report.html import render
 
+    log.info("stage report: %s", design.name)
     summary = summary_json(result)
     atomic_write_text(folder / "summary.json", summary)
     atomic_write_text(folder / "sweep.csv", sweep_csv(result))
@@ -255,20 +329,23 @@ def write_report(design: Design, folder: Path, result: CheckResult, manifest: di
 
 def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: int | None = None,
           executor: Executor | None = None, options: Mapping[str, Any] | None = None,
-          progress: ProgressFactory = no_progress) -> CheckRun:
-    """Build into ``folder``, sweep, apply the mesh-resolution rule, confirm the worst poses on
-    the exact B-rep and write report.html, summary.json and sweep.csv beside the CAD."""
-    from gearcheck.output import ensure_out_dir
+          progress: ProgressFactory = no_progress, overrides: Sequence[str] = (),
+          extra_files: Mapping[str, str] | None = None) -> CheckRun:
+    """Build, sweep, apply the mesh-resolution rule, confirm the worst poses on the exact B-rep
+    and write report.html, summary.json and sweep.csv beside the CAD — all as one transaction
+    (:class:`gearcheck.output.RunFolder`): ``folder`` ends up holding this whole run, or, if
+    anything fails or interrupts it, the previous run untouched."""
+    from gearcheck.output import RunFolder
 
     check_tol(tol_mm)
-    folder = ensure_out_dir(folder)
-    # the report files of an earlier run would describe other meshes: gone until this run writes its own
-    for stale in REPORT_FILES:
-        (folder / stale).unlink(missing_ok=True)
-    run = build(design, folder, tol_mm=tol_mm, progress=progress)
-    result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
-                   progress=progress)
-    apply_resolution_rule(design, result, run.bodies, run.tol_mm)
-    result.confirmations = confirm(result, run.parts, run.bodies, progress)
-    files, summary = write_report(design, folder, result, run.manifest)
-    return CheckRun(run, result, run.files + files, summary)
+    with RunFolder(folder) as txn:
+        run = _build_into(design, txn.staging, tol_mm, progress, overrides)
+        result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
+                       progress=progress)
+        apply_resolution_rule(design, result, run.bodies, run.tol_mm)
+        result.confirmations = confirm(result, run.parts, run.bodies, progress)
+        _, summary = write_report(design, txn.staging, result, run.manifest)
+        run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
+        target = txn.commit()
+    _rooted(run, target, ["manifest.json", *run.manifest["files"]])
+    return CheckRun(run, result, run.files, summary)

@@ -159,6 +159,9 @@ def build_bevel_gear(spec: BevelGearSpec, flank_points: int = FLANK_SPLINE_POINT
     sector = _common(loft, blank)
     t2 = time.perf_counter()
 
+    solids = sector.Solids()
+    if len(solids) != 1:  # e.g. an empty blank (its meridian polygon turned inside out)
+        raise RuntimeError(f"tooth sector ∩ blank gave {len(solids)} solids, expected 1")
     half = math.pi / spec.teeth
     faces = sector.Faces()
     kept = [f for f in faces if not _is_side_face(f, half)]

@@ -59,7 +59,8 @@ class BevelGearSpec:
     thinning_mm: circumferential tooth thinning at the outer pitch circle (backlash allowance);
     the thinning tapers to the apex with the tooth.
     mounting_distance_mm / front_face_distance_mm: apex to the back (mounting) face and to the
-    front (toe) face, along the axis; None puts each BLANK_RIM_MODULES modules under the root.
+    front (toe) face, along the axis; None puts each BLANK_RIM_MODULES modules under the root
+    (the front face at most halfway from the inner root corner to the back face).
     """
 
     teeth: int
@@ -204,12 +205,16 @@ class BevelGearSpec:
     @property
     def front_face_distance(self) -> float:
         """Apex → front (toe) face along the axis (mm); default BLANK_RIM_MODULES·m under the
-        inner root along the front cone."""
+        inner root along the front cone, but never past halfway from the inner root corner to
+        the back face: a back face close behind the roots (a flat gear mounted near its heel,
+        e.g. a ring gear) keeps a web between the two faces instead of a front face behind the
+        back face (a blank turned inside out)."""
         if self.front_face_distance_mm is not None:
             return self.front_face_distance_mm
         d = self.pitch_angle_rad
         rho, z = self._root_corner(self.inner_cone_distance_mm)
-        return z + BLANK_RIM_MODULES * self.module_mm * math.sin(d)
+        rim = z + BLANK_RIM_MODULES * self.module_mm * math.sin(d)
+        return min(rim, 0.5 * (z + self.mounting_distance))
 
     def blank_profile(self) -> np.ndarray:
         """Closed meridian polygon (ρ, z), counter-clockwise, of the blank to revolve about z.
@@ -237,10 +242,13 @@ class BevelGearSpec:
         rho_b = on_cone_at_z(re, z_back)
         root_in = self._root_corner(ri)[0]
         root_out = self._root_corner(re)[0]
-        if not (r_bore < rho_f < root_in):
-            raise ValueError("front_face_distance_mm must put the front face under the inner root")
+        # the back face first: the default front face is placed from it
         if not rho_b < root_out:
             raise ValueError("mounting_distance_mm must put the back face under the outer root")
+        if not (r_bore < rho_f < root_in):
+            raise ValueError("front_face_distance_mm must put the front face under the inner root")
+        if not z_front < z_back:
+            raise ValueError("front_face_distance_mm must put the front face in front of the back face")
         pts.append((r_bore, z_front))
         pts.append((rho_f, z_front))
         pts.append(on_cone_and_outer(ri))
@@ -571,49 +579,3 @@ def mate_rotation(spec: BevelGearSpec, angle_rad: float, mate: BevelGearSpec | N
 
     mate_angle = math.pi / mate.teeth - angle_rad * spec.teeth / mate.teeth
     return rot_z(-angle_rad) @ mount @ rot_z(mate_angle)
-
-
-# -- analytic volume (for checking built solids) ----------------------------------------
-def _revolved_volume(poly: np.ndarray) -> float:
-    """Volume of revolution about z of a closed CCW polygon in (ρ, z): 2π ∫∫ ρ dA."""
-    x, y = poly[:, 0], poly[:, 1]
-    x1, y1 = np.roll(x, -1), np.roll(y, -1)
-    return float(2 * math.pi * np.sum((x + x1) * (x * y1 - x1 * y)) / 6.0)
-
-
-def _clip_polygon(poly: np.ndarray, keep) -> np.ndarray:
-    """Sutherland–Hodgman clip by the half-plane keep(p) = n·p ≥ 0 (n given as a function)."""
-    out = []
-    for i in range(len(poly)):
-        a, b = poly[i], poly[(i + 1) % len(poly)]
-        fa, fb = keep(a), keep(b)
-        if fa >= 0:
-            out.append(a)
-        if (fa >= 0) != (fb >= 0):
-            out.append(a + (b - a) * fa / (fa - fb))
-    return np.array(out)
-
-
-def analytic_volume_mm3(spec: BevelGearSpec, nodes: int = 400) -> float:
-    """Volume (mm³) of the finished gear from the geometry alone (no CAD): the blank under
-    the root cone (Pappus on the clipped meridian polygon) plus the teeth,
-
-        V_teeth = z ∫_{θf}^{θa} w(θ) · (Re³ − Ri³) / (3 cos³(θ − δ)) · sin θ dθ
-
-    with w(θ) = 2·flank_azimuth(θ, +1) the tooth's azimuth width (back and front cones bound a
-    ray at r = Re / cos(θ − δ) and Ri / cos(θ − δ)). Gauss–Legendre, split at δb.
-    """
-    t = math.tan(spec.root_angle_rad)
-    under_root = _clip_polygon(spec.blank_profile(), lambda p: p[1] * t - p[0])
-    volume = _revolved_volume(under_root)
-    d = spec.pitch_angle_rad
-    re, ri = spec.outer_cone_distance_mm, spec.inner_cone_distance_mm
-    cuts = sorted({spec.root_angle_rad, spec.face_angle_rad,
-                   min(max(spec.base_angle_rad, spec.root_angle_rad), spec.face_angle_rad)})
-    x, w = np.polynomial.legendre.leggauss(nodes)
-    for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
-        th = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
-        width = 2 * flank_azimuth(spec, th, +1)
-        f = width * (re**3 - ri**3) / (3 * np.cos(th - d) ** 3) * np.sin(th)
-        volume += spec.teeth * 0.5 * (hi - lo) * float(w @ f)
-    return volume

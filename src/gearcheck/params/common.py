@@ -10,10 +10,13 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 import tomllib
 import typing
+from collections.abc import Callable
+from decimal import ROUND_HALF_EVEN, Decimal, localcontext
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import annotated_types as at
 from pydantic import BaseModel, ConfigDict, ValidationError
@@ -25,6 +28,11 @@ MAX_TEMPLATE_BYTES = 1_000_000
 # Deepest nesting a template may have (a template is sections of keys, a key may hold a flat
 # list: 3 levels); deeper documents are rejected before anything walks them recursively.
 MAX_NESTING = 8
+# Checked on the text before tomllib parses it (tomllib's time and memory grow with the square of
+# a dotted key's length: one 40,000-part key in 80 KB took 30 s and 6 GB to reject). The shipped
+# templates hold ~40 keys in ~8 tables on ~60 lines, nested at most 3 deep; these allow 250x that.
+MAX_TEMPLATE_LINES = 20_000
+MAX_TEMPLATE_ENTRIES = 10_000  # keys, [tables], arrays, inline tables and array items together
 # Longest value shown in an error line (strings, e.g. paths, get more room than numbers).
 MAX_SHOWN_CHARS = 60
 MAX_SHOWN_STRING_CHARS = 300
@@ -65,6 +73,69 @@ def bisect_boundary(ok, good: float, bad: float, steps: int) -> float | None:
     if not ok(good):
         return None
     return bisect(lambda x: not ok(x), good, bad, tol=None, max_iter=steps, check_ends=False).free
+
+
+# A bound that fails its rule's own test after rounding steps inward by one unit of its last
+# digit at most this many times (the rule and the bound's computation differ by float rounding
+# or a root finder's tolerance, far below one printed unit).
+MAX_BOUND_STEPS = 3
+# A range narrower than a unit of the requested digits gets up to this many more digits.
+MAX_EXTRA_DIGITS = 6
+
+
+def fmt_bound(value: float, side: str, digits: int | None = 3,
+              ok: Callable[[float], bool] | None = None, strict: bool = False) -> str:
+    """A computed bound as a rejection prints it, rounded INWARD at ``digits`` decimals: a
+    ``"lower"`` bound up, an ``"upper"`` bound down, so that the number read back from the text
+    lies inside the allowed range (a closed bound printed is itself accepted; an open one, '>x'
+    or '<x', prints a range inside the true one). The comparison is on the float the text reads
+    back as, so a bound already on the grid (0.505·8 = 4.04) prints as it is.
+
+    digits None: the shortest text that reads back as exactly ``value`` (a bound that is another
+    input, e.g. 'allowed < sleeve diameter 8.5 mm'). ``ok``: the rule's own test of a value, for
+    a bound computed apart from the rule (by a root finder, or in other arithmetic); the printed
+    bound steps inward until ``ok`` accepts it (at most MAX_BOUND_STEPS units) or, ``strict``
+    (an open bound, not itself allowed), accepts the float just inside it.
+    """
+    if side not in ("lower", "upper"):
+        raise ValueError(f"side must be 'lower' or 'upper', not {side!r}")
+    if digits is None:
+        short = f"{value:g}"
+        return short if float(short) == value else repr(value)
+    lower = side == "lower"
+    unit = Decimal(1).scaleb(-digits)
+    with localcontext() as ctx:
+        ctx.prec = 60
+        d = Decimal(value).quantize(unit, rounding=ROUND_HALF_EVEN)
+        if (float(d) < value) if lower else (float(d) > value):
+            d += unit if lower else -unit
+        for _ in range(MAX_BOUND_STEPS):
+            if ok is None:
+                break
+            probe = float(d)
+            if strict:
+                probe = math.nextafter(probe, math.inf if lower else -math.inf)
+            if ok(probe):
+                break
+            d += unit if lower else -unit
+        if d == 0:
+            d = abs(d)  # no '-0.000'
+        return f"{d:f}"
+
+
+def fmt_range(lo: float, hi: float, digits: int | None = 3, *, lo_open: bool = False, hi_open: bool = False,
+              lo_ok: Callable[[float], bool] | None = None, hi_ok: Callable[[float], bool] | None = None) -> str:
+    """'lo to hi' ('>lo', '<hi' for open ends), each end rounded inward (:func:`fmt_bound`); a
+    range narrower than one unit at ``digits`` gets more digits, so its printed ends stay ordered."""
+    extra = 0
+    while True:
+        n = None if digits is None else digits + extra
+        a = fmt_bound(lo, "lower", n, lo_ok, strict=lo_open)
+        b = fmt_bound(hi, "upper", n, hi_ok, strict=hi_open)
+        if n is None or lo > hi or float(a) <= float(b) or extra >= MAX_EXTRA_DIGITS:
+            break  # (an empty range, lo > hi, is the caller's to word)
+        extra += 1
+    return f"{'>' if lo_open else ''}{a} to {'<' if hi_open else ''}{b}"
 
 
 def _one_line(text: str) -> str:
@@ -198,6 +269,9 @@ def parse_override(text: str) -> tuple[tuple[str, ...], Any]:
     raw = raw.strip()
     if len(path) > MAX_NESTING:
         raise ParamError("--set", key, f"key nested {len(path)} levels deep; allowed at most {MAX_NESTING}")
+    problem = _prescan(f"v = {raw}", len(path) - 1)  # tomllib is quadratic on long dotted keys
+    if problem is not None:
+        raise ParamError("--set", key, f"value: {problem[1]}")
     try:
         value = tomllib.loads(f"v = {raw}")["v"]
     except tomllib.TOMLDecodeError:
@@ -246,6 +320,165 @@ def apply_values(data: dict, values: dict[str, Any]) -> dict:
     return out
 
 
+# The lexical pre-scan (_prescan) reads TOML's structure only: keys, [table] headers, the brackets
+# of arrays and inline tables, commas, line ends; strings and comments are skipped whole (a "." or
+# "[" in them is not structure). Possessive quantifiers: no backtracking, linear time.
+_BASIC = r'"(?:[^"\\\n]|\\.)*+"'
+_LITERAL = r"'[^'\n]*+'"
+_ML_BASIC = r'"""(?:[^"\\]|\\[\s\S]|"(?!""))*+"""(?:"{0,2})'  # up to 2 quotes after """ are content
+_ML_LITERAL = r"'''[\s\S]*?'''(?:'{0,2})"
+_STRING = "(?:" + "|".join((_ML_BASIC, _ML_LITERAL, _BASIC, _LITERAL)) + ")"
+_COMMENT = r"#[^\n]*+"
+_KEY_PART = r"(?:[A-Za-z0-9_-]++|" + _BASIC + "|" + _LITERAL + ")"
+_KEY_PART_RE = re.compile(_KEY_PART)
+_KEY_RE = re.compile(_KEY_PART + r"(?:[ \t]*+\.[ \t]*+" + _KEY_PART + ")*+")
+_HEADER_RE = re.compile(r"\[(\[?)[ \t]*+(" + _KEY_RE.pattern + r")[ \t]*+\]")
+_EQUALS_RE = re.compile(r"[ \t]*+=")
+_BLANK_RE = re.compile(r"(?:[ \t\r\n]++|" + _COMMENT + ")*+")
+# inside a value, everything up to the next bracket (and line end / comma where they end it)
+_SKIP_TOP_RE = re.compile(r"(?:[^\[\]{}\"'#\n]++|" + _STRING + "|" + _COMMENT + ")*+")
+_SKIP_ARRAY_RE = re.compile(r"(?:[^\[\]{}\"'#]++|" + _STRING + "|" + _COMMENT + ")*+")
+_SKIP_INLINE_RE = re.compile(r"(?:[^\[\]{}\"'#,]++|" + _STRING + "|" + _COMMENT + ")*+")
+_STRING_OR_COMMENT_RE = re.compile(_STRING + "|" + _COMMENT)  # cut out before counting an array's commas
+
+
+def _key_parts(key: str) -> int:
+    if '"' in key or "'" in key:
+        return sum(1 for _ in _KEY_PART_RE.finditer(key))  # a quoted part may hold dots
+    return key.count(".") + 1
+
+
+def _shown_key(key: str) -> str:
+    return repr(key if len(key) <= 40 else key[:37] + "...")
+
+
+def _prescan(text: str, level: int = 0) -> tuple[int, str] | None:
+    """Refuse, before tomllib parses it, a text too deep or too large for a template: keys and
+    [table] headers of more than MAX_NESTING levels (counting the table a key sits in and the
+    arrays / inline tables around it, as _check_nesting counts them), more than
+    MAX_TEMPLATE_ENTRIES keys, tables and array items, more than MAX_TEMPLATE_LINES lines. Returns
+    (line, problem) (line 0: the whole text) or None. Linear time, a few regex matches per key
+    or bracket. ``level``: the level of the text's top table (0 for a file).
+
+    Nesting is counted as the parsed document nests (``[a.b]`` then ``c = [1]``: 1 at level 4),
+    so the scan never refuses what _check_nesting accepts; a ``[x.y]`` under an array of tables
+    ``[[x]]`` nests one level deeper than counted here, which _check_nesting still catches after
+    parsing. Text that is not valid TOML ends the scan: tomllib stops no later than the scan did
+    and names the line."""
+    lines = text.count("\n") + 1
+    if lines > MAX_TEMPLATE_LINES:
+        return 0, f"{lines} lines; a template has at most {MAX_TEMPLATE_LINES}"
+    scan = _Scan(text, level)
+    want_key: bool | None = True
+    try:
+        while want_key is not None:
+            want_key = scan.key() if want_key else scan.value()
+    except _Refused as exc:
+        return exc.line, exc.problem
+    return None
+
+
+class _Refused(Exception):
+    def __init__(self, line: int, problem: str):
+        super().__init__(line, problem)
+        self.line, self.problem = line, problem
+
+
+class _Scan:
+    """_prescan's reading position and what encloses it. ``key`` and ``value`` each read one
+    step and say what comes next: True a key, False more of a value, None nothing (the text
+    ends, or is not TOML there); a limit passed raises _Refused."""
+
+    def __init__(self, text: str, level: int):
+        self.text = text
+        self.pos = 0
+        self.top = level  # level of the text's top table
+        self.base = level  # level of the current [table]
+        self.stack: list[tuple[str, int]] = []  # open arrays "[" and inline tables "{", with their level
+        self.value_level: int | None = None  # level of a value that may start here (None: none may)
+        self.entries = 0
+
+    def refuse(self, problem: str) -> NoReturn:
+        raise _Refused(self.text.count("\n", 0, self.pos) + 1, problem)
+
+    def count_entries(self, count: int = 1) -> None:
+        self.entries += count
+        if self.entries > MAX_TEMPLATE_ENTRIES:
+            self.refuse(f"more than {MAX_TEMPLATE_ENTRIES} keys, tables and array items; "
+                        f"a template allows at most {MAX_TEMPLATE_ENTRIES}")
+
+    def key(self) -> bool | None:
+        """A key and its '=', or a [table] / [[array.of.tables]] header."""
+        text = self.text
+        self.pos = _match_end(_BLANK_RE, text, self.pos)
+        if self.pos >= len(text):
+            return None
+        if self.stack and text[self.pos] == "}":  # {} or a trailing comma: closed by value()
+            self.value_level = None
+            return False
+        header = _HEADER_RE.match(text, self.pos) if not self.stack and text[self.pos] == "[" else None
+        found = header or _KEY_RE.match(text, self.pos)
+        if found is None:
+            return None
+        name = found.group(2) if header else found.group()
+        if header:
+            array = bool(header.group(1))
+            depth = self.top + _key_parts(name) + array
+            what = f"table {'[[' if array else '['}{_shown_key(name)[1:-1]}{']]' if array else ']'}"
+        else:
+            depth = (self.stack[-1][1] if self.stack else self.base) + _key_parts(name)
+            what = f"key {_shown_key(name)}"
+        if depth > MAX_NESTING:
+            self.refuse(f"{what} nested {depth} levels deep; a template allows at most {MAX_NESTING}")
+        self.count_entries()
+        if header:
+            self.base, self.pos, self.value_level = depth, header.end(), None
+            if array and text.startswith("]", self.pos):
+                self.pos += 1
+            return False
+        equals = _EQUALS_RE.match(text, found.end())
+        if equals is None:
+            return None
+        self.pos, self.value_level = equals.end(), depth
+        return False
+
+    def value(self) -> bool | None:
+        """A value (skipped whole, strings and comments included) up to the next bracket, comma
+        of an inline table or line end."""
+        stack = self.stack
+        skip = _SKIP_TOP_RE if not stack else _SKIP_ARRAY_RE if stack[-1][0] == "[" else _SKIP_INLINE_RE
+        start, self.pos = self.pos, _match_end(skip, self.text, self.pos)
+        if skip is _SKIP_ARRAY_RE and self.text.count(",", start, self.pos):  # the items of an array
+            self.count_entries(_STRING_OR_COMMENT_RE.sub("", self.text[start:self.pos]).count(","))
+        if self.pos >= len(self.text):
+            return None
+        char = self.text[self.pos]
+        want_key: bool | None = False
+        if char in "\n,":  # a line end outside brackets, or a comma in an inline table: a key
+            want_key = True
+        elif char in "[{" and self.value_level is not None:
+            if self.value_level > MAX_NESTING:
+                self.refuse(f"arrays / inline tables nested more than {MAX_NESTING} levels deep; "
+                            f"a template allows at most {MAX_NESTING}")
+            self.count_entries()
+            stack.append((char, self.value_level))
+            self.value_level += 1  # an array's items are one level deeper; a table's keys say
+            want_key = char == "{"
+        elif stack and char == {"[": "]", "{": "}"}[stack[-1][0]]:
+            stack.pop()
+            self.value_level = stack[-1][1] + 1 if stack and stack[-1][0] == "[" else None
+        else:  # a bracket out of place, a string that does not end: not TOML
+            want_key = None
+        self.pos += 1
+        return want_key
+
+
+def _match_end(pattern: re.Pattern[str], text: str, pos: int) -> int:
+    """Where ``pattern`` (one that matches the empty string too) ends when matched at ``pos``."""
+    found = pattern.match(text, pos)
+    return found.end() if found is not None else pos
+
+
 def read_toml(path: Path) -> dict:
     """Read a template file; every way it can be unreadable is a ParamError naming the file."""
     source = str(path)
@@ -265,6 +498,10 @@ def read_toml(path: Path) -> dict:
         raise ParamError("", None, f"not UTF-8 text (byte {exc.start}): is this a TOML template?", source) from None
     except OSError as exc:
         raise ParamError("", None, f"cannot read: {exc.strerror}", source) from None
+    problem = _prescan(text)
+    if problem is not None:
+        line, what = problem
+        raise ParamError("", None, f"line {line}: {what}" if line else what, source)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -304,28 +541,11 @@ def _reject_non_finite(node: Any, path: tuple[str, ...], source: str, model: typ
                          else "must be a finite number", source)
 
 
-def to_toml(data: dict) -> str:
-    """Write a template back as TOML (top-level scalars, then one table per section).
+def to_toml(data: dict, comment: str = "") -> str:
+    """A template (or a run's resolved parameters) as TOML, written by a TOML library (tomli-w:
+    every string escaped as TOML requires, floats exact), with an optional leading comment
+    (one line per line of ``comment``, control characters shown escaped)."""
+    import tomli_w
 
-    Templates hold scalars, strings and flat lists only, so this small writer is exact for them;
-    floats use repr, which round-trips. Used to record the resolved parameters next to results.
-    """
-
-    def value(v: Any) -> str:
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, (int, float)):
-            return repr(v)
-        if isinstance(v, str):
-            return '"' + v.replace("\\", "\\\\").replace('"', '\\"') + '"'
-        if isinstance(v, list):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        raise TypeError(f"cannot write {type(v).__name__} to a template")
-
-    lines = [f"{k} = {value(v)}" for k, v in data.items() if not isinstance(v, dict)]
-    for section, body in data.items():
-        if isinstance(body, dict):
-            lines.append("")
-            lines.append(f"[{section}]")
-            lines.extend(f"{k} = {value(v)}" for k, v in body.items())
-    return "\n".join(lines) + "\n"
+    head = "".join(f"# {_one_line(line)}\n" for line in comment.splitlines())
+    return head + tomli_w.dumps(data)

@@ -16,7 +16,7 @@ import math
 from pydantic import Field, model_validator
 
 from gearcheck.mechanisms.differential import analysis, poses  # numpy only
-from gearcheck.params.common import ParamError, Section, bisect_boundary
+from gearcheck.params.common import ParamError, Section, bisect_boundary, fmt_bound, fmt_range
 
 # The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
 # d2/2, a/2 = l2 + d1/2). 0.05 mm is about 3′ of backlash per side (eq 11): within what the
@@ -24,6 +24,7 @@ from gearcheck.params.common import ParamError, Section, bisect_boundary
 APEX_TOLERANCE_MM = 0.05
 MAX_STUDY_SHIMS = 12
 MATERIAL_NAME_MAX = 40
+SHIFT_MIN, SHIFT_MAX = -1.0, 1.5  # the small gear's profile shift coefficient (field range)
 
 
 def _unit(unit: str) -> dict:
@@ -45,7 +46,7 @@ class Gears(Section):
     shaft_angle_deg: float = Field(description="angle between big and small gear axes; the model needs 90",
                                    json_schema_extra=_unit("deg"))
     small_profile_shift: float = Field(
-        ge=-1.0, le=1.5,
+        ge=SHIFT_MIN, le=SHIFT_MAX,
         description="profile shift coefficient x of the small gear (the big gear gets −x: long/short addendum)",
         json_schema_extra=_unit("× module"),
     )
@@ -62,46 +63,31 @@ class Gears(Section):
         max_face = analysis.MAX_FACE_WIDTH_FRACTION * geom.outer_cone_distance_mm
         if self.face_width_mm > max_face:
             raise ParamError("gears.face_width_mm", self.face_width_mm,
-                             f"allowed <= {max_face:.2f} mm: one third of the outer cone distance "
+                             f"allowed <= {fmt_bound(max_face, 'upper', 2)} mm: one third of the outer cone distance "
                              f"Re = {geom.outer_cone_distance_mm:.2f} mm (teeth too thin at the inner end)")
         alpha = math.radians(self.pressure_angle_deg)
         mesh = analysis.virtual_mesh(geom, alpha, self.small_profile_shift)
         x = self.small_profile_shift
-        x_max = analysis.max_small_shift_for_tip(geom, alpha)
-        x_min = max(mesh.small_undercut_min_shift, analysis.min_small_shift_for_interference(geom, alpha))
-        shift_range = (f"allowed {x_min:.3f} to {x_max:.3f}" if x_min <= x_max else
-                       f"no shift allowed at {self.small_teeth}/{self.big_teeth} teeth and "
-                       f"{self.pressure_angle_deg:g}° "
-                       f"(no undercut needs >= {x_min:.3f}, a 0.25·m tip land <= {x_max:.3f})")
-        if x < mesh.small_undercut_min_shift:
-            raise ParamError("gears.small_profile_shift", x,
-                             f"{shift_range}: the small gear is undercut "
-                             f"(virtual tooth count z/cos δ = {geom.small_virtual_teeth:.2f} < "
-                             f"{2.0 / math.sin(alpha) ** 2:.1f}); Gleason's rule gives {mesh.gleason_small_shift:.2f}")
-        if mesh.big_tip_path_mm > mesh.big_tip_path_limit_mm:
-            raise ParamError("gears.small_profile_shift", x,
-                             f"{shift_range}: the big gear's tip runs inside the small gear's base circle "
-                             f"(tip interference on the back-cone virtual pair); Gleason's rule gives "
-                             f"{mesh.gleason_small_shift:.2f}")
         min_tip = analysis.MIN_TIP_THICKNESS_MODULES * self.module_mm
-        if mesh.small_tip_thickness_mm < min_tip:
-            raise ParamError("gears.small_profile_shift", x,
-                             f"{shift_range}: pointed teeth, the small gear's tip is "
-                             f"{mesh.small_tip_thickness_mm:.3f} mm thick on the back cone, less than "
-                             f"0.25·m = {min_tip:.3f} mm")
-        if mesh.big_tip_thickness_mm < min_tip:
-            # the big gear (shift −x) thins as x falls
-            x_low = _boundary(lambda v: analysis.virtual_mesh(geom, alpha, v).big_tip_thickness_mm >= min_tip, x_max, x)
-            bound = f"allowed >= {x_low:.3f}" if x_low is not None else "no shift allowed up to the small gear's limit"
-            raise ParamError("gears.small_profile_shift", x,
-                             f"{bound}: pointed teeth, the big gear's tip (shift −x) is "
-                             f"{mesh.big_tip_thickness_mm:.3f} mm thick on the back cone, less than 0.25·m = "
-                             f"{min_tip:.3f} mm")
-        if mesh.contact_ratio < analysis.MIN_CONTACT_RATIO:
-            raise ParamError("gears.small_profile_shift", x,
-                             f"contact ratio of the back-cone virtual pair is {mesh.contact_ratio:.3f}, allowed >= "
-                             f"{analysis.MIN_CONTACT_RATIO}: a tooth pair lets go before the next engages "
-                             "(lower the shift or the pressure angle)")
+        failed = [name for name, ok in _shift_rules(geom, alpha, min_tip).items() if not ok(x)]
+        if not failed:
+            return self
+        shift_range = _shift_range(geom, alpha, min_tip, f"{self.small_teeth}/{self.big_teeth} teeth and "
+                                                         f"{self.pressure_angle_deg:g}°")
+        why = {
+            "undercut": f"the small gear is undercut (virtual tooth count z/cos δ = {geom.small_virtual_teeth:.2f}: "
+                        f"no undercut needs x >= 1 − zv·sin²α/2 = {mesh.small_undercut_min_shift:.3f})",
+            "interference": "the big gear's tip runs inside the small gear's base circle (tip interference on the "
+                            "back-cone virtual pair)",
+            "small tip": f"pointed teeth, the small gear's tip is {mesh.small_tip_thickness_mm:.3f} mm thick on the "
+                         f"back cone, less than 0.25·m = {min_tip:.3f} mm",
+            "big tip": f"pointed teeth, the big gear's tip (shift −x) is {mesh.big_tip_thickness_mm:.3f} mm thick on "
+                       f"the back cone, less than 0.25·m = {min_tip:.3f} mm",
+            "contact ratio": f"contact ratio of the back-cone virtual pair is {mesh.contact_ratio:.3f} < "
+                             f"{analysis.MIN_CONTACT_RATIO}: a tooth pair lets go before the next engages",
+        }[failed[0]]
+        raise ParamError("gears.small_profile_shift", x,
+                         f"{shift_range}: {why}; Gleason's rule gives {mesh.gleason_small_shift:.2f}")
         return self
 
 
@@ -234,15 +220,18 @@ class Params(Section):
         geom = analysis.cone_geometry(self.gears.module_mm, self.gears.big_teeth, self.gears.small_teeth)
         d = self.dimensions
         b_apex = 2.0 * (d.l11_mm + d.l12_mm + geom.small_pitch_diameter_mm / 2.0)
-        if abs(d.b_mm - b_apex) > APEX_TOLERANCE_MM:
+        b_lo, b_hi = b_apex - APEX_TOLERANCE_MM, b_apex + APEX_TOLERANCE_MM
+        if not b_lo <= d.b_mm <= b_hi:
             raise ParamError("dimensions.b_mm", d.b_mm,
-                             f"allowed {b_apex:.3f} ± {APEX_TOLERANCE_MM} mm: the big pitch circles must meet the "
-                             "common apex, b/2 = l11 + l12 + d2/2 (change l11_mm or l12_mm with it)")
+                             f"allowed {fmt_range(b_lo, b_hi)} mm ({b_apex:.3f} ± {APEX_TOLERANCE_MM}): the big pitch "
+                             "circles must meet the common apex, b/2 = l11 + l12 + d2/2 (change l11_mm or l12_mm "
+                             "with it)")
         a_apex = 2.0 * (d.l2_mm + geom.big_pitch_diameter_mm / 2.0)
-        if abs(d.a_mm - a_apex) > APEX_TOLERANCE_MM:
+        a_lo, a_hi = a_apex - APEX_TOLERANCE_MM, a_apex + APEX_TOLERANCE_MM
+        if not a_lo <= d.a_mm <= a_hi:
             raise ParamError("dimensions.a_mm", d.a_mm,
-                             f"allowed {a_apex:.3f} ± {APEX_TOLERANCE_MM} mm: the small pitch circles must meet the "
-                             "common apex, a/2 = l2 + d1/2 (change l2_mm with it)")
+                             f"allowed {fmt_range(a_lo, a_hi)} mm ({a_apex:.3f} ± {APEX_TOLERANCE_MM}): the small "
+                             "pitch circles must meet the common apex, a/2 = l2 + d1/2 (change l2_mm with it)")
         gain = analysis.shim_gain(geom, math.radians(self.gears.pressure_angle_deg), self.shim.thickness_mm)
         warm_min_per_side = analysis.big_gear_arcmin(self.backlash.mesh_thinning_min_mm, geom) + gain.per_side_arcmin
         if warm_min_per_side <= 0.0:
@@ -281,12 +270,60 @@ def _boundary(ok, good: float, bad: float) -> float | None:
     return bisect_boundary(ok, good, bad, steps=50)
 
 
+def _shift_rules(geom, alpha: float, min_tip: float) -> dict:
+    """The small gear's profile shift rules, in the order they are checked: each a test of x.
+    Undercut, tip interference and the big gear's tip land bound x from below (the big gear gets
+    −x); the small gear's tip land and the contact ratio from above."""
+
+    def at(v: float) -> analysis.VirtualMesh:
+        return analysis.virtual_mesh(geom, alpha, v)
+
+    return {
+        "undercut": lambda v: v >= at(v).small_undercut_min_shift,
+        "interference": lambda v: at(v).big_tip_path_mm <= at(v).big_tip_path_limit_mm,
+        "small tip": lambda v: at(v).small_tip_thickness_mm >= min_tip,
+        "big tip": lambda v: at(v).big_tip_thickness_mm >= min_tip,
+        "contact ratio": lambda v: at(v).contact_ratio >= analysis.MIN_CONTACT_RATIO,
+    }
+
+
+def _shift_range(geom, alpha: float, min_tip: float, where: str) -> str:
+    """'allowed lo to hi' for the small gear's profile shift under all of :func:`_shift_rules`
+    (each end rounded inward and checked against those rules), or why no shift works."""
+    rules = _shift_rules(geom, alpha, min_tip)
+
+    def low_ok(v: float) -> bool:
+        return rules["undercut"](v) and rules["interference"](v) and rules["big tip"](v)
+
+    def high_ok(v: float) -> bool:
+        return rules["small tip"](v) and rules["contact ratio"](v)
+
+    x_hi: float | None = analysis.max_small_shift_for_tip(geom, alpha)
+    x_lo: float | None = max(analysis.virtual_mesh(geom, alpha, 0.0).small_undercut_min_shift,
+                             analysis.min_small_shift_for_interference(geom, alpha))
+    if x_lo is not None and x_hi is not None and not rules["big tip"](x_lo):
+        # the big gear's tip thins as x falls: its least shift, found from the small gear's limit down
+        x_lo = _boundary(rules["big tip"], x_hi, x_lo)
+    if x_lo is not None and x_hi is not None and not rules["contact ratio"](x_hi):
+        # the contact ratio falls as x grows past its peak: the largest shift that keeps it
+        x_hi = _boundary(rules["contact ratio"], x_lo, x_hi)
+    if x_lo is not None and x_hi is not None:  # inside the field's own range
+        x_lo, x_hi = max(x_lo, SHIFT_MIN), min(x_hi, SHIFT_MAX)
+    if x_lo is None or x_hi is None or x_lo > x_hi:
+        return (f"no shift allowed at {where} (no undercut, tip interference or pointed big gear needs x above the "
+                "shifts that keep the small gear's tip land and a contact ratio >= 1)")
+    return f"allowed {fmt_range(x_lo, x_hi, lo_ok=low_ok, hi_ok=high_ok)}"
+
+
 def _blame(params: Params, why: str) -> ParamError:
     g, d = params.gears, params.dimensions
     geom = analysis.cone_geometry(g.module_mm, g.big_teeth, g.small_teeth)
 
     def cured(section: str, **values) -> bool:
-        blocker = _cad_blocker(_with(params, section, **values))
+        return cures(_with(params, section, **values))
+
+    def cures(changed: Params) -> bool:
+        blocker = _cad_blocker(changed)
         return blocker is None or blocker.split(":")[0] != why.split(":", maxsplit=1)[0]
 
     if "mounting_distance" in why:  # a back (mounting) face in front of its gear's outer root
@@ -294,19 +331,34 @@ def _blame(params: Params, why: str) -> ParamError:
         far = 500.0
         small_a = lambda v: 2.0 * (v + geom.big_pitch_diameter_mm / 2.0)  # noqa: E731  a/2 = l2 + d1/2
         if not cured("dimensions", l12_mm=far):
-            l2 = _boundary(lambda v: cured("dimensions", l12_mm=far, a_mm=small_a(v)), far, d.l2_mm)
-            bound = f"allowed >= {l2:.3f} mm" if l2 is not None else f"no length up to {far:g} mm allowed"
+            def l2_ok(v: float) -> bool:
+                return cured("dimensions", l12_mm=far, a_mm=small_a(v))
+
+            l2 = _boundary(l2_ok, far, d.l2_mm)
+            bound = (f"allowed >= {fmt_bound(l2, 'lower', ok=l2_ok)} mm" if l2 is not None
+                     else f"no length up to {far:g} mm allowed")
             return ParamError("dimensions.l2_mm", d.l2_mm,
                               f"{bound}: the small gear's mounting face (a/2 = l2 + d1/2 from the apex) must lie "
                               "behind its outer root (change a_mm with it)")
-        l12 = _boundary(lambda v: cured("dimensions", l12_mm=v), far, d.l12_mm)
-        bound = f"allowed >= {l12:.3f} mm" if l12 is not None else f"no length up to {far:g} mm allowed"
+        def l12_ok(v: float) -> bool:
+            return cured("dimensions", l12_mm=v)
+
+        l12 = _boundary(l12_ok, far, d.l12_mm)
+        bound = (f"allowed >= {fmt_bound(l12, 'lower', ok=l12_ok)} mm" if l12 is not None
+                 else f"no length up to {far:g} mm allowed")
         return ParamError("dimensions.l12_mm", d.l12_mm,
                           f"{bound}: the big gear's body must reach behind its outer root "
                           "(back face d2/2 + l12 from the apex; change b_mm with it)")
     if "front_face" in why:  # the bore does not fit under the inner (toe) root
-        m = _boundary(lambda v: cured("gears", module_mm=v), 10.0, g.module_mm)
-        bound = f"allowed >= {m:.3f} mm at these tooth counts" if m is not None else "no module up to 10 mm allowed"
+        def module_ok(v: float) -> bool:  # with a and b moved to keep the common apex, as they must
+            changed = _with(params, "gears", module_mm=v)
+            return cures(_with(changed, "dimensions", a_mm=2.0 * (d.l2_mm + v * g.big_teeth / 2.0),
+                               b_mm=2.0 * (d.l11_mm + d.l12_mm + v * g.small_teeth / 2.0)))
+
+        m = _boundary(module_ok, 10.0, g.module_mm)
+        bound = (f"allowed >= {fmt_bound(m, 'lower', ok=module_ok)} mm at these tooth counts (a_mm, b_mm moved "
+                 "with it)" if m is not None
+                 else "no module up to 10 mm allowed")
         return ParamError("gears.module_mm", g.module_mm,
                           f"{bound}: the gear bores ({poses.BIG_GEAR_BORE_MM:g} mm big, "
                           f"{poses.SMALL_GEAR_BORE_MM:g} mm "

@@ -19,7 +19,7 @@ from pydantic import Field, model_validator
 
 from gearcheck.mechanisms.steering import analysis, layout
 from gearcheck.params import ParamError, Section
-from gearcheck.params.common import bisect_boundary
+from gearcheck.params.common import bisect_boundary, fmt_bound, fmt_range
 
 MM: dict[str, Any] = {"unit": "mm"}
 DEG: dict[str, Any] = {"unit": "deg"}
@@ -28,6 +28,7 @@ DEG: dict[str, Any] = {"unit": "deg"}
 MIN_TOP_LAND_MODULES = 0.25
 ADDENDUM_MIN = 0.5  # least pinion addendum coefficient (field range)
 TEETH_MAX = 400  # most pinion teeth (field range)
+RACK_ADDENDUM_MIN, RACK_ADDENDUM_MAX = 0.5, 1.5  # rack addendum coefficient (field range)
 
 
 class Pinion(Section):
@@ -53,7 +54,7 @@ class Rack(Section):
     first_tooth: int = Field(ge=-200, le=-2,
         description="Index k of the first rack tooth (trimmed at S2/S6); tooth k is centred at k·p at angle 0")
     last_tooth: int = Field(ge=2, le=200, description="Index k of the last rack tooth (mirror trims)")
-    addendum_coefficient: float = Field(ge=0.5, le=1.5,
+    addendum_coefficient: float = Field(ge=RACK_ADDENDUM_MIN, le=RACK_ADDENDUM_MAX,
         description="Rack addendum above its reference line, in modules")
     dedendum_coefficient: float = Field(ge=0.5, le=2.0,
         description="Rack dedendum below its reference line, in modules")
@@ -134,24 +135,25 @@ def _check(p: Params) -> None:
     # (The shift moves the rack's reference line with the pinion, so it cancels in both.)
     if rack.dedendum_coefficient <= pin.addendum_coefficient:
         raise ParamError("rack.dedendum_coefficient", rack.dedendum_coefficient,
-                         f"allowed > {pin.addendum_coefficient:g} "
+                         f"allowed > {fmt_bound(pin.addendum_coefficient, 'lower', None)} "
                          "(pinion addendum: the pinion tip must clear the rack root)")
     if pin.dedendum_coefficient <= rack.addendum_coefficient:
         raise ParamError("pinion.dedendum_coefficient", pin.dedendum_coefficient,
-                         f"allowed > {rack.addendum_coefficient:g} "
+                         f"allowed > {fmt_bound(rack.addendum_coefficient, 'lower', None)} "
                          "(rack addendum: the rack tip must clear the pinion root)")
     depth = (pin.dedendum_coefficient - x) * m
     if depth > r * math.sin(a) ** 2:
-        z_min = 2.0 * (pin.dedendum_coefficient - x) / math.sin(a) ** 2
-        raise ParamError("pinion.teeth", z,
-                         f"undercut by the generating rack at this shift and dedendum: allowed >= {math.ceil(z_min)}")
+        raise _undercut_error(p, depth, a)
     g = analysis.geometry_from_params(p)
     _check_tooth_forms(g)
     rack_root = H - r - x * m - rack.dedendum_coefficient * m
     if rack_root <= 0:
+        def root_above(v: float) -> bool:
+            return v - r - x * m - rack.dedendum_coefficient * m > 0
+
+        h_min = fmt_bound(r + x * m + rack.dedendum_coefficient * m, "lower", ok=root_above, strict=True)
         raise ParamError("layout.centre_to_datum_mm", H,
-                         f"allowed > {r + x * m + rack.dedendum_coefficient * m:g} mm "
-                         "(the rack root must lie above its datum)")
+                         f"allowed > {h_min} mm (the rack root must lie above its datum)")
 
     # Trims: between the rolling line and the rack tooth top; hS4 must keep the contact ratio >= 1.
     h = H - r
@@ -162,33 +164,88 @@ def _check(p: Params) -> None:
     def h_for_ratio(eps: float) -> float:
         return h + math.sin(a) * (eps * base_pitch - recess)
 
-    eps_top = ((top - h) / math.sin(a) + recess) / base_pitch
+    def untrimmed_ratio(rack_addendum: float) -> float:  # ε with the rack top at this addendum
+        return ((H - r - x * m + rack_addendum * m - h) / math.sin(a) + recess) / base_pitch
+
+    eps_top = untrimmed_ratio(rack.addendum_coefficient)
     if eps_top < 1.0:
-        # contact ratio 1 needs the rack top at h1; the rack addendum sets the top
-        ha_min = (analysis.trim_height_for_contact_ratio(g, 1.0) - g.rack_reference_height) / m
+        raise _untrimmed_ratio_error(g, eps_top, untrimmed_ratio)
+    if not top > h:
         raise ParamError("rack.addendum_coefficient", rack.addendum_coefficient,
-                         f"allowed >= {ha_min:.3f}: the untrimmed rack's contact ratio is {eps_top:.3f} < 1 "
-                         "(a tooth pair lets go before the next engages)")
-    for name in ("hS2_mm", "hS4_mm", "hS6_mm", "hS8_mm"):
-        value = getattr(trim, name)
-        lo = max(h, h_for_ratio(1.0)) if name == "hS4_mm" else h
-        why = ("contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm"
-               else "above the rack pitch line, at most the rack tooth top")
-        if not (lo < value <= top):
-            raise ParamError(f"trim.{name}", value, f"allowed >{lo:.3f} to {top:.3f} mm ({why})")
+                         f"allowed > {fmt_bound(x, 'lower', None)} (pinion.profile_shift): the rack tooth top "
+                         f"({top:.3f} mm) must lie above the rolling line ({h:.3f} mm), where the trims hS2–hS8 lie")
+    rs1 = pin.topped_radius_mm
+    rs1_lo = max(H - trim.hS2_mm, _form_radius(r, rb, a, depth))
+    _check_trim_ranges(g, h, top, max(h, h_for_ratio(1.0)), rs1_lo < rs1 <= tip)
     if trim.min_contact_ratio > eps_top:
         raise ParamError("trim.min_contact_ratio", trim.min_contact_ratio,
-                         f"allowed 1 to {eps_top:.3f} (the untrimmed rack's contact ratio)")
+                         f"allowed 1 to {fmt_bound(eps_top, 'upper')} (the untrimmed rack's contact ratio)")
 
     # RS1: G1's tip circle must reach down to S2 (it is the last corner that drags the rack),
     # and topping only removes material.
-    rs1 = pin.topped_radius_mm
-    rs1_lo = max(H - trim.hS2_mm, _form_radius(r, rb, a, depth))
     if not (rs1_lo < rs1 <= tip):
         raise ParamError("pinion.topped_radius_mm", rs1,
-                         f"allowed >{rs1_lo:.3f} to {tip:.3f} mm "
+                         f"allowed {fmt_range(rs1_lo, tip, lo_open=True)} mm "
                          "(G1's tip circle must reach S2 at height hS2; at most the tip radius)")
     _check_trim_clearance(g)
+
+
+def _undercut_error(p: Params, depth: float, a: float) -> ParamError:
+    """Pinion undercut: the least count with no undercut (in the rule's own arithmetic) whose
+    root circle also clears the bore (the later rule on the same field)."""
+    pin = p.pinion
+    m, z = pin.module_mm, pin.teeth
+    drawing = analysis.geometry_from_params(p)
+
+    def teeth_ok(n: int) -> bool:
+        return (depth <= m * n / 2.0 * math.sin(a) ** 2
+                and layout.bore_fits(analysis.with_inputs(drawing, teeth=n).root_radius))
+
+    z_min = max(math.ceil(2.0 * (pin.dedendum_coefficient - pin.profile_shift) / math.sin(a) ** 2), z + 1)
+    z_ok = next((n for n in range(z_min, TEETH_MAX + 1) if teeth_ok(n)), None)
+    bound = f"allowed >= {z_ok}" if z_ok is not None else f"no count allowed up to {TEETH_MAX}"
+    return ParamError("pinion.teeth", z,
+                      f"undercut by the generating rack at this shift and dedendum: {bound} (with the root "
+                      f"circle clear of the {layout.PINION_BORE_DIAMETER_MM:g} mm bore)")
+
+
+def _untrimmed_ratio_error(g, eps_top: float, untrimmed_ratio) -> ParamError:
+    """Contact ratio 1 needs the rack top at h1: the rack addendum sets the top, and a higher
+    top must still leave the rack tooth a top land (both inside the field's range)."""
+    m = g.module_mm
+    ha_min = max((analysis.trim_height_for_contact_ratio(g, 1.0) - g.rack_reference_height) / m, RACK_ADDENDUM_MIN)
+    ha_max = min(_rack_addendum_max(g), RACK_ADDENDUM_MAX)
+    why = f"the untrimmed rack's contact ratio is {eps_top:.3f} < 1 (a tooth pair lets go before the next engages)"
+    if ha_min > ha_max:
+        return ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient,
+                          f"no value allowed: {why}; contact ratio 1 needs >= {fmt_bound(ha_min, 'lower')}, a "
+                          f"{MIN_TOP_LAND_MODULES}·m top land <= {fmt_bound(ha_max, 'upper')} (raise "
+                          "pinion.addendum_coefficient or lower pinion.pressure_angle_deg)")
+    ha_range = fmt_range(ha_min, ha_max, lo_ok=lambda v: untrimmed_ratio(v) >= 1.0,
+                         hi_ok=lambda v: _rack_top_land_ok(g, v))
+    return ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient, f"allowed {ha_range}: {why}")
+
+
+def _check_trim_ranges(g, h: float, top: float, hs4_min: float, rs1_ok: bool) -> None:
+    """Each trim height between the rolling line h (hS4: where the contact ratio reaches 1) and
+    the rack tooth top. The printed top of S8 and S6 is also under the tangents the tip circles
+    sweep over them (_check_trim_clearance): from hS4, and from hS2 with RS1 when RS1 (checked
+    next) is in its range."""
+    for name in ("hS2_mm", "hS4_mm", "hS6_mm", "hS8_mm"):
+        value = getattr(g, name)
+        lo = hs4_min if name == "hS4_mm" else h
+        why = ("contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm"
+               else "above the rack pitch line, at most the rack tooth top")
+        hi = top
+        if name == "hS8_mm":
+            hi = min(top, _hs8_max(g))
+        elif name == "hS6_mm" and rs1_ok:
+            hi = min(top, _hs6_max(g))
+        if hi < top:
+            why += (" and the pinion tip circle's tangent (hS8_max)" if name == "hS8_mm"
+                    else " and G1's topped tip circle's tangent (hS6_max)")
+        if not (lo < value <= top):
+            raise ParamError(f"trim.{name}", value, f"allowed {fmt_range(lo, hi, lo_open=True)} mm ({why})")
 
 
 def _check_tooth_forms(g) -> None:
@@ -205,37 +262,59 @@ def _check_tooth_forms(g) -> None:
     if pinion_tip_land(g) < land_min:
         lo = ADDENDUM_MIN
         if pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=lo)) < land_min:
-            x_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, profile_shift=v)) >= land_min, -1.0, x)
+            def shift_ok(v: float) -> bool:
+                return pinion_tip_land(analysis.with_inputs(g, profile_shift=v)) >= land_min
+
+            x_max = bisect_boundary(shift_ok, -1.0, x, steps=60)
+            bound = (f"allowed <= {fmt_bound(x_max, 'upper', ok=shift_ok)}" if x_max is not None
+                     else "no shift allowed down to -1 at this addendum")
             raise ParamError("pinion.profile_shift", x,
-                             f"allowed <= {x_max:.3f}: pointed pinion teeth, tip land "
+                             f"{bound}: pointed pinion teeth, tip land "
                              f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
-        ha_max = _boundary(lambda v: pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v))
-                           >= land_min,
-                           lo, g.pinion_addendum_coefficient)
+
+        def addendum_ok(v: float) -> bool:
+            return pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v)) >= land_min
+
+        ha_max = _boundary(addendum_ok, lo, g.pinion_addendum_coefficient)
         raise ParamError("pinion.addendum_coefficient", g.pinion_addendum_coefficient,
-                         f"allowed <= {ha_max:.3f} at this shift: pointed pinion teeth, tip land "
+                         f"allowed <= {fmt_bound(ha_max, 'upper', ok=addendum_ok)} at this shift: pointed pinion "
+                         "teeth, tip land "
                          f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
     w0 = g.rack_half_thickness_at_rolling_line
     if g.cutter_tip_half_width <= 0.0:
+        def cutter_ok(v: float) -> bool:
+            return analysis.with_inputs(g, pinion_dedendum_coefficient=v).cutter_tip_half_width > 0.0
+
+        hf_max = fmt_bound(x + w0 / (m * tan_a), "upper", ok=cutter_ok, strict=True)
         raise ParamError("pinion.dedendum_coefficient", g.pinion_dedendum_coefficient,
-                         f"allowed < {x + w0 / (m * tan_a):.3f} at this shift and pressure angle: the generating "
+                         f"allowed < {hf_max} at this shift and pressure angle: the generating "
                          "rack's tip comes to a point, leaving no root land between the pinion's fillets")
-    rack_top_land = 2.0 * float(g.rack_half_width(g.rack_top_height))
+    rack_top_land = _rack_top_land(g)
     if rack_top_land < land_min:
+        rack_ha_max = fmt_bound(_rack_addendum_max(g), "upper", ok=lambda v: _rack_top_land_ok(g, v))
         raise ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient,
-                         f"allowed <= {x + (w0 - land_min / 2.0) / (m * tan_a):.3f}: pointed rack teeth, top land "
+                         f"allowed <= {rack_ha_max}: pointed rack teeth, top land "
                          f"{rack_top_land:.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
-    if not 2.0 * float(g.rack_half_width(g.rack_root_height)) < g.pitch:
+    def root_space_ok(v: float) -> bool:
+        at = analysis.with_inputs(g, rack_dedendum_coefficient=v)
+        return 2.0 * float(at.rack_half_width(at.rack_root_height)) < at.pitch
+
+    if not root_space_ok(g.rack_dedendum_coefficient):
+        hf_max = fmt_bound((g.pitch / 2.0 - w0) / (m * tan_a) - x, "upper", ok=root_space_ok, strict=True)
         raise ParamError("rack.dedendum_coefficient", g.rack_dedendum_coefficient,
-                         f"allowed < {(g.pitch / 2.0 - w0) / (m * tan_a) - x:.3f}: adjacent rack teeth would "
+                         f"allowed < {hf_max}: adjacent rack teeth would "
                          "meet above the rack root line (no tooth space left)")
     if not layout.bore_fits(g.root_radius):
         z_min = next((n for n in range(g.teeth + 1, TEETH_MAX + 1)
                       if layout.bore_fits(analysis.with_inputs(g, teeth=n).root_radius)), None)
         if z_min is None:
-            m_min = _boundary(lambda v: layout.bore_fits(analysis.with_inputs(g, module_mm=v).root_radius), 50.0, m)
+            def module_ok(v: float) -> bool:
+                return layout.bore_fits(analysis.with_inputs(g, module_mm=v).root_radius)
+
+            m_min = _boundary(module_ok, 50.0, m)
             raise ParamError("pinion.module_mm", m,
-                             f"allowed >= {m_min:.3f} mm at z = {g.teeth}: the root circle "
+                             f"allowed >= {fmt_bound(m_min, 'lower', ok=module_ok)} mm at z = {g.teeth}: the root "
+                             "circle "
                              f"(radius {g.root_radius:.2f} mm) "
                              f"must clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
         raise ParamError("pinion.teeth", g.teeth,
@@ -243,25 +322,55 @@ def _check_tooth_forms(g) -> None:
                          f"clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
 
 
+def _rack_top_land(g) -> float:
+    return 2.0 * float(g.rack_half_width(g.rack_top_height))
+
+
+def _rack_top_land_ok(g, rack_addendum: float) -> bool:
+    """The rack top land rule of :func:`_check_tooth_forms` at this rack addendum."""
+    return _rack_top_land(analysis.with_inputs(g, rack_addendum_coefficient=rack_addendum)) >= \
+        MIN_TOP_LAND_MODULES * g.module_mm
+
+
+def _rack_addendum_max(g) -> float:
+    """Largest rack addendum coefficient that leaves the rack a 0.25·m top land."""
+    land_min = MIN_TOP_LAND_MODULES * g.module_mm
+    return g.profile_shift + (g.rack_half_thickness_at_rolling_line - land_min / 2.0) / \
+        (g.module_mm * math.tan(g.pressure_angle_rad))
+
+
 def _check_trim_clearance(g) -> None:
     """The trimmed tops S4–S8 and S2–S6 must stay under the tangents the pinion's tip circles
     (Ra at S4, RS1 at S2) sweep over them (paper eqs (8)–(16), :func:`analysis.tangent_top_height`,
     the construction `gearcheck calc` reports as hS8_max / hS6_max): a higher corner is one the
     pinion tip cannot clear, so it drags the rack on past the designed disengagement."""
-    first = g.rack_first_tooth
-    travel_s3s4 = analysis.travel_corner_on_circle(g, first + 1, g.hS4_mm, g.tip_radius)
-    hs8_max = analysis.tangent_top_height(g, g.trim_corners(travel_s3s4)["S4"], first + 1, travel_s3s4)
+    hs8_max = _hs8_max(g)
     h = g.rolling_line_height
     if g.hS8_mm > hs8_max:
         raise ParamError("trim.hS8_mm", g.hS8_mm,
-                         f"allowed >{h:.3f} to {hs8_max:.3f} mm: the pinion tip circle (Ra) cannot clear S8 above "
+                         f"allowed {fmt_range(h, hs8_max, lo_open=True)} mm: the pinion tip circle (Ra) cannot "
+                         "clear S8 above "
                          "its tangent at S4 (hS8_max)")
-    travel_s1s2 = analysis.travel_corner_on_circle(g, first, g.hS2_mm, g.topped_radius_mm)
-    hs6_max = analysis.tangent_top_height(g, g.trim_corners(travel_s1s2)["S2"], first, travel_s1s2)
+    hs6_max = _hs6_max(g)
     if g.hS6_mm > hs6_max:
         raise ParamError("trim.hS6_mm", g.hS6_mm,
-                         f"allowed >{h:.3f} to {hs6_max:.3f} mm: G1's topped tip circle (RS1) cannot clear S6 above "
+                         f"allowed {fmt_range(h, hs6_max, lo_open=True)} mm: G1's topped tip circle (RS1) cannot "
+                         "clear S6 above "
                          "its tangent at S2 (hS6_max)")
+
+
+def _hs8_max(g) -> float:
+    """Highest S8 under the tangent the tip circle (Ra) sweeps over it from S4."""
+    first = g.rack_first_tooth
+    travel = analysis.travel_corner_on_circle(g, first + 1, g.hS4_mm, g.tip_radius)
+    return analysis.tangent_top_height(g, g.trim_corners(travel)["S4"], first + 1, travel)
+
+
+def _hs6_max(g) -> float:
+    """Highest S6 under the tangent G1's topped tip circle (RS1) sweeps over it from S2."""
+    first = g.rack_first_tooth
+    travel = analysis.travel_corner_on_circle(g, first, g.hS2_mm, g.topped_radius_mm)
+    return analysis.tangent_top_height(g, g.trim_corners(travel)["S2"], first, travel)
 
 
 def _boundary(ok, good: float, bad: float) -> float:

@@ -16,6 +16,7 @@ from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
 from gearcheck.mechanisms.track import analysis, layout
 from gearcheck.params import ParamError, Section
+from gearcheck.params.common import fmt_bound, fmt_range
 
 MIN_TEETH = 7
 MAX_TEETH = 301
@@ -107,32 +108,37 @@ class Params(Section):
                              "engaging, an odd z lets each tooth take its turn (wear alternates)")
         if not c.pin_diameter_mm < dr:
             raise ParamError("chain.pin_diameter_mm", c.pin_diameter_mm,
-                             f"allowed < sleeve diameter {dr:g} mm (the pin runs inside the sleeve)")
+                             f"allowed < sleeve diameter {fmt_bound(dr, 'upper', None)} mm (the pin runs inside the "
+                             "sleeve)")
         if not s.initial_pitch_diameter_mm > p:
             raise ParamError("sprocket.initial_pitch_diameter_mm", s.initial_pitch_diameter_mm,
-                             f"allowed > chain pitch {p:g} mm")
+                             f"allowed > chain pitch {fmt_bound(p, 'lower', None)} mm")
         d = iso606.every_other_tooth_pitch_diameter(p, z)
         chord = iso606.groove_chord(d, z)
         lim = iso606.seating_limits(dr, z)
         # No tooth is left when even the smallest ISO seating circles (0.505·dR) of adjacent
         # grooves touch.
         if not lim.seating_radius_min_mm * 2.0 < chord:
+            def leaves_tooth(v: float) -> bool:
+                return iso606.seating_limits(v, z).seating_radius_min_mm * 2.0 < chord
+
+            dr_max = fmt_bound(chord / 1.01, "upper", ok=leaves_tooth, strict=True)
             raise ParamError("chain.sleeve_diameter_mm", dr,
-                             f"allowed < {chord / 1.01:.3f} mm at z = {z}, p = {p:g} mm: seating circles "
+                             f"allowed < {dr_max} mm at z = {z}, p = {p:g} mm: seating circles "
                              f"(0.505·dR) of adjacent grooves {chord:.3f} mm apart must leave a tooth")
         ri_hi = min(lim.seating_radius_max_mm, 0.5 * chord)
         if not lim.seating_radius_min_mm <= s.seating_radius_mm <= ri_hi:
             bound = "" if ri_hi == lim.seating_radius_max_mm else f" (capped at half the groove chord {chord:.3f} mm)"
             raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm,
-                             f"allowed {lim.seating_radius_min_mm:.3f} to {ri_hi:.3f} mm: ISO 606 limits "
+                             f"allowed {fmt_range(lim.seating_radius_min_mm, ri_hi)} mm: ISO 606 limits "
                              f"for dR = {dr:g} mm{bound}")
         if not lim.flank_radius_min_mm <= s.flank_radius_mm <= lim.flank_radius_max_mm:
             raise ParamError("sprocket.flank_radius_mm", s.flank_radius_mm,
-                             f"allowed {lim.flank_radius_min_mm:.2f} to {lim.flank_radius_max_mm:.2f} mm: "
+                             f"allowed {fmt_range(lim.flank_radius_min_mm, lim.flank_radius_max_mm, 2)} mm: "
                              f"ISO 606 limits for dR = {dr:g} mm, z = {z}")
         if not lim.seating_angle_min_deg <= s.seating_angle_deg <= lim.seating_angle_max_deg:
             raise ParamError("sprocket.seating_angle_deg", s.seating_angle_deg,
-                             f"allowed {lim.seating_angle_min_deg:.2f} to {lim.seating_angle_max_deg:.2f}°: "
+                             f"allowed {fmt_range(lim.seating_angle_min_deg, lim.seating_angle_max_deg, 2)}°: "
                              f"ISO 606 limits for z = {z}")
         self._check_tip_land(d)
         self._check_widths_and_loads()
@@ -146,27 +152,54 @@ class Params(Section):
         bf_max = iso606.iso_tooth_width_max(c.sleeve_inner_width_mm, p)
         if not s.tooth_width_mm <= bf_max:
             raise ParamError("sprocket.tooth_width_mm", s.tooth_width_mm,
-                             f"allowed <= {bf_max:.3f} mm: ISO 606 bf1 max for b1 = {c.sleeve_inner_width_mm:g} mm")
+                             f"allowed <= {fmt_bound(bf_max, 'upper')} mm: ISO 606 bf1 max for "
+                             f"b1 = {c.sleeve_inner_width_mm:g} mm")
         if not c.sleeve_inner_width_mm < c.pin_support_span_mm:
+            b2 = fmt_bound(c.pin_support_span_mm, "upper", None)
             raise ParamError("chain.sleeve_inner_width_mm", c.sleeve_inner_width_mm,
-                             f"allowed < pin support span b2 = {c.pin_support_span_mm:g} mm")
+                             f"allowed < pin support span b2 = {b2} mm")
         total = s.tooth_rows * s.tooth_width_mm + (s.tooth_rows - 1) * s.middle_groove_width_mm
         if not total <= c.track_width_mm:
-            raise ParamError("sprocket.middle_groove_width_mm", s.middle_groove_width_mm,
-                             f"rows and grooves span {total:g} mm; allowed total <= track width "
-                             f"{c.track_width_mm:g} mm")
+            raise self._width_error(total)
         if not self.strength.loaded_tooth_rows <= s.tooth_rows:
             raise ParamError("strength.loaded_tooth_rows", self.strength.loaded_tooth_rows,
                              f"allowed 1 to {s.tooth_rows} (sprocket.tooth_rows)")
         g = self.ground
         if not g.adhesion_coefficient > g.rolling_resistance_coefficient:
+            f = fmt_bound(g.rolling_resistance_coefficient, "lower", None)
             raise ParamError("ground.adhesion_coefficient", g.adhesion_coefficient,
-                             f"allowed > rolling resistance f = {g.rolling_resistance_coefficient:g} "
-                             "(else the track has no drive force)")
+                             f"allowed > rolling resistance f = {f} (else the track has no drive force)")
         t = self.track_plate
         if not t.required_gap_min_mm <= t.required_gap_max_mm:
+            gap_max = fmt_bound(t.required_gap_max_mm, "upper", None)
             raise ParamError("track_plate.required_gap_min_mm", t.required_gap_min_mm,
-                             f"allowed <= required_gap_max_mm = {t.required_gap_max_mm:g} mm")
+                             f"allowed <= required_gap_max_mm = {gap_max} mm")
+
+    def _width_error(self, total: float) -> ParamError:
+        """Rows and grooves wider than the track: the middle groove's own bound when the rows
+        alone fit, else the tooth width's."""
+        s, width = self.sprocket, self.chain.track_width_mm
+        n, bf, groove = s.tooth_rows, s.tooth_width_mm, s.middle_groove_width_mm
+        grooves = f"{n - 1} groove{'s' if n > 2 else ''}"
+        parts = f"{n} rows and {grooves} span" if n > 1 else "the tooth row spans"
+        span = f"{parts} {total:g} mm, more than the track width {width:g} mm"
+        if n > 1 and n * bf < width:
+            def fits(v: float) -> bool:
+                return n * bf + (n - 1) * v <= width
+
+            groove_max = fmt_bound((width - n * bf) / (n - 1), "upper", ok=fits)
+            return ParamError("sprocket.middle_groove_width_mm", groove,
+                              f"allowed <= {groove_max} mm with {n} rows of {bf:g} mm: {span}")
+        if (n - 1) * groove < width:
+            def rows_fit(v: float) -> bool:
+                return n * v + (n - 1) * groove <= width
+
+            bf_fit = fmt_bound((width - (n - 1) * groove) / n, "upper", ok=rows_fit)
+            with_grooves = f" with {n} rows and {groove:g} mm grooves" if n > 1 else ""
+            return ParamError("sprocket.tooth_width_mm", bf, f"allowed <= {bf_fit} mm{with_grooves}: {span}")
+        return ParamError("sprocket.middle_groove_width_mm", groove,
+                          f"allowed < {fmt_bound(width / (n - 1), 'upper', strict=True)} mm: the {grooves} alone "
+                          f"span the track width {width:g} mm")
 
     def _check_buildable(self) -> None:
         """Build the layout `gearcheck build` builds its solids from (:mod:`.layout`, the same
@@ -188,7 +221,8 @@ class Params(Section):
                 d = iso606.every_other_tooth_pitch_diameter(p, teeth)
                 return layout.hub_radius_mm(d, s.seating_radius_mm) > bore / 2.0
 
-            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if fits(n)), None)
+            # (the chain wrap, checked next, needs enough teeth too: the least count passes both)
+            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if fits(n) and _wrap_fits(n, p)), None)
             allowed = f"allowed odd {z_min} to {MAX_TEETH}" if z_min else f"no odd count up to {MAX_TEETH} allowed"
             raise ParamError("sprocket.teeth", z,
                              f"{allowed} at p = {p:g} mm: the {bore:g} mm shaft bore must lie under the "
@@ -197,8 +231,9 @@ class Params(Section):
             layout.default_wrap(z, p)
         except ValueError as exc:
             z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if _wrap_fits(n, p)), None)
+            allowed = f"allowed odd {z_min} to {MAX_TEETH}" if z_min else f"no odd count up to {MAX_TEETH} allowed"
             raise ParamError("sprocket.teeth", z,
-                             f"allowed odd {z_min} to {MAX_TEETH}: the chain segment built at θ = 0 "
+                             f"{allowed}: the chain segment built at θ = 0 "
                              f"({layout.DEFAULT_WRAP_ANGLE_DEG:g}° wrap plus {layout.DEFAULT_RUN_LINKS} links on "
                              f"each run) does not fit: {exc}") from None
         try:
@@ -214,8 +249,13 @@ class Params(Section):
         e_max = _largest_joining_offset(c.pitch_mm, c.sleeve_diameter_mm, c.track_width_mm)
         gap_lo, gap_hi = max(-e_at_zero_gap, TIP_GAP_MIN_MM), e_max - e_at_zero_gap
         if gap_lo < gap_hi:
+            def joins(v: float) -> bool:
+                return _joins(c.pitch_mm, c.sleeve_diameter_mm, analysis.plate_offset_for_tip_gap(gap, v),
+                              c.track_width_mm)
+
             return ParamError("track_plate.tip_gap_mm", t.tip_gap_mm,
-                              f"allowed {gap_lo:.3f} to {gap_hi:.3f} mm: the link plate's face (e = tip gap + "
+                              f"allowed {fmt_range(gap_lo, gap_hi, lo_ok=joins, hi_ok=joins)} mm: the link plate's "
+                              f"face (e = tip gap + "
                               f"{e_at_zero_gap:.3f} mm outside the pin line) must cut the {c.sleeve_diameter_mm:g} mm "
                               "sleeve deep enough to join it")
         # No tip gap works: the sleeve is too thin. Smallest sleeve that joins at the least gap.
@@ -224,8 +264,12 @@ class Params(Section):
         for _ in range(60):
             mid = 0.5 * (lo + hi)
             lo, hi = (lo, mid) if _largest_joining_offset(c.pitch_mm, mid, c.track_width_mm) > e_needed else (mid, hi)
+        def joins_at_least_gap(v: float) -> bool:
+            return _largest_joining_offset(c.pitch_mm, v, c.track_width_mm) > e_needed
+
+        dr_min = fmt_bound(hi, "lower", ok=joins_at_least_gap, strict=True)
         return ParamError("chain.sleeve_diameter_mm", c.sleeve_diameter_mm,
-                          f"allowed > {hi:.3f} mm: a thinner sleeve cannot join the link plate, whose face lies "
+                          f"allowed > {dr_min} mm: a thinner sleeve cannot join the link plate, whose face lies "
                           f"{e_needed:.3f} mm outside the pin line at the least tip gap {TIP_GAP_MIN_MM} mm")
 
 
@@ -242,7 +286,8 @@ class Params(Section):
                                  f"{self.chain.sleeve_diameter_mm:g} mm too large for the "
                                  f"{iso606.groove_chord(d, s.teeth):.3f} mm groove chord with this ri, re, α)")
             raise ParamError("sprocket.tip_over_pitch_mm", s.tip_over_pitch_mm,
-                             f"allowed < {limit - d:.3f} mm: the flanks of adjacent grooves meet "
+                             f"allowed < {fmt_bound(limit - d, 'upper', ok=lambda v: d + v < limit, strict=True)} mm: "
+                             "the flanks of adjacent grooves meet "
                              f"{(limit - d) / 2:.3f} mm above the pitch circle, no tip land above that")
         try:
             iso606.tooth_gap(d, s.teeth, s.seating_radius_mm, s.flank_radius_mm, s.seating_angle_deg,
@@ -256,11 +301,7 @@ def _largest_joining_offset(pitch_mm: float, sleeve_diameter_mm: float, track_wi
     for e in (0, e_max)); 0 if none."""
 
     def joins(e: float) -> bool:
-        try:
-            tc.link_geometry(pitch_mm, sleeve_diameter_mm, e, track_width_mm)
-        except ValueError:
-            return False
-        return True
+        return _joins(pitch_mm, sleeve_diameter_mm, e, track_width_mm)
 
     lo, hi = 0.0, sleeve_diameter_mm / 2.0
     if not joins(hi * 1e-9):
@@ -269,6 +310,15 @@ def _largest_joining_offset(pitch_mm: float, sleeve_diameter_mm: float, track_wi
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if joins(mid) else (lo, mid)
     return lo
+
+
+def _joins(pitch_mm: float, sleeve_diameter_mm: float, plate_offset_mm: float, track_width_mm: float) -> bool:
+    """Whether :func:`track_chain.link_geometry` builds a link with this plate offset e."""
+    try:
+        tc.link_geometry(pitch_mm, sleeve_diameter_mm, plate_offset_mm, track_width_mm)
+    except ValueError:
+        return False
+    return True
 
 
 def _wrap_fits(teeth: int, pitch_mm: float) -> bool:
