@@ -29,8 +29,16 @@ from gearcheck.sweep.motion import ChainLink, Rotation, Translation
 from spur_pair import TEMPLATE as SPUR_TEMPLATE
 from spur_pair import SpurPair
 
-registry.register(SpurPair)
-NAMES = registry.names()
+# the shipped mechanisms (entry points) and the test-defined spur pair, registered while this
+# module's tests run (so other modules see only the installed registry)
+NAMES = sorted({*registry.names(), SpurPair.name})
+
+
+@pytest.fixture(scope="module", autouse=True)
+def spur_registered():
+    registry.register(SpurPair)
+    yield
+    registry.unregister(SpurPair.name)
 EXAMPLES = {"spur_pair": SPUR_TEMPLATE}
 ROOT = Path(__file__).resolve().parents[1]
 

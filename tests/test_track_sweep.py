@@ -112,7 +112,7 @@ def test_sweep_modules_do_not_import_cadquery():
             "gearcheck.mechanisms.track.sweep, gearcheck.mechanisms.track.verdicts, "
             "gearcheck.mechanisms.track.report, gearcheck.geometry.track_section; "
             "sys.exit(any(m.split('.')[0] in ('cadquery', 'OCP') for m in sys.modules))")
-    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+    assert subprocess.run([sys.executable, "-c", code], check=False).returncode == 0
 
 
 # --- the sweep on the generated meshes ----------------------------------------------------------
@@ -155,7 +155,9 @@ def test_template_sweep_verdicts_and_figures(template_run):
                                                   "min_tip_plate_distance", "contact_proven", "mesh_agrees_with_exact"}
     # coverage: at least one whole cycle, every pose counted by the progress callback
     assert s["cycles_covered"] >= 1.0
-    assert s["poses"] == len(result.rows) == progressed
+    # (the declared chain wear adds the same poses again for the worn chain: tests/test_track_wear.py)
+    assert s["poses"] == len(result.rows) == s["wear"]["mesh_declared_poses"]
+    assert progressed == 2 * s["poses"]
     assert s["cycle_deg"] == pytest.approx(720.0 / loaded.params.sprocket.teeth)
     # no interference anywhere; the seated sleeve's clearance ri − R is resolved beyond the bound
     assert s["collisions"] == 0 and not any(r["collide"] for r in result.rows)

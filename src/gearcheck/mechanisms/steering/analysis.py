@@ -69,12 +69,29 @@ PAPER = {
 
 
 
+# The paper's design as the template holds it: every input of the drawing and of the design chain
+# (towing.max_angle_deg only sets how far the check swings, so it may differ).
+PAPER_DESIGN = {
+    "pinion": {"module_mm": 4.0, "teeth": 42, "profile_shift": 0.0, "pressure_angle_deg": 25.0,
+               "addendum_coefficient": 1.0, "dedendum_coefficient": 1.25, "sector_first_tooth": -8,
+               "sector_last_tooth": 7, "topped_radius_mm": 84.294},
+    "rack": {"first_tooth": -7, "last_tooth": 7, "addendum_coefficient": 1.0, "dedendum_coefficient": 1.25},
+    "layout": {"centre_to_datum_mm": 107.0},
+    "trim": {"min_contact_ratio": 1.2, "hS2_mm": 25.13, "hS4_mm": 25.13, "hS6_mm": 25.51, "hS8_mm": 25.51},
+    "targets": {"continuous_angle_deg": 60.0},
+}
+
+
 def is_paper_design(params) -> bool:
-    """The template is the paper's mechanism (m 4, z 42, α 25°, H 107): only then do its printed
-    figures stand beside the results (beside another design they would read as targets)."""
-    p = params.pinion
-    return (math.isclose(p.module_mm, 4.0) and p.teeth == 42 and math.isclose(p.pressure_angle_deg, 25.0)
-            and math.isclose(params.layout.centre_to_datum_mm, 107.0))
+    """The template is the paper's mechanism (:data:`PAPER_DESIGN`: module, teeth, α, H, RS1, the
+    four trims, the design rules): only then do its printed figures stand beside the results
+    (beside another design they would read as targets)."""
+    for section, values in PAPER_DESIGN.items():
+        got = getattr(params, section)
+        for key, value in values.items():
+            if not math.isclose(float(getattr(got, key)), float(value), rel_tol=0.0, abs_tol=1e-9):
+                return False
+    return True
 
 
 def geometry_from_params(params) -> RackPinionGeometry:

@@ -9,6 +9,7 @@ import dataclasses
 import math
 
 from gearcheck.figures import Figure
+from gearcheck.geometry.rack_pinion_contact import stop_phrase, whole_drive
 from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.mechanisms.steering.params import Params
 
@@ -45,7 +46,8 @@ def calc(params: Params) -> list[Figure]:
     phi_s1 = an.phi_towing_conjugate_end(g, first_j)
     phi_s6 = an.phi_power_conjugate_end(g, first_k, g.hS6_mm)
     phi_s6_paper = an.phi_power_conjugate_end(g, first_k, hs6_half)
-    continuous = min(an.continuous_towing_angle(g), an.continuous_power_angle(g))
+    drive = min(whole_drive(g), key=lambda d: d.angle_rad)  # towing and power, every hand-over
+    continuous = drive.angle_rad
 
     # --- towing push model -----------------------------------------------------------------
     max_deg = params.towing.max_angle_deg
@@ -115,9 +117,9 @@ def calc(params: Params) -> list[Figure]:
         F("alpha_S6_deg", "pressure angle at S6, αS6 (eq 18)", _deg(an.pressure_angle_at_power_corner(g, g.hS6_mm)),
           "deg", paper=P["alpha_S6_deg"],
           note=f"{_deg(an.pressure_angle_at_power_corner(g, hs6_half)):.2f} at the paper's-lines hS6"),
-        F("continuous_angle_deg", "continuous drive to (min of towing S1, power S6)", _deg(continuous), "deg",
+        F("continuous_angle_deg", "continuous drive to (towing and power, every hand-over)", _deg(continuous), "deg",
           paper=P["phi_S6_deg"],
-          note=f"ADAMS 62-63°, test {P['test_continuous_deg']:g}° (backlash, deflection)"),
+          note=f"{drive.event}; ADAMS 62-63°, test {P['test_continuous_deg']:g}° (backlash, deflection)"),
         F("continuous_margin_deg", "continuous drive beyond targets.continuous_angle_deg",
           _deg(continuous) - params.targets.continuous_angle_deg, "deg",
           note="≥ 0: power-steering requirement met"),
@@ -132,9 +134,11 @@ def calc(params: Params) -> list[Figure]:
           paper=P["travel_disengage_mm"],
           note=beyond or f"S1 rounded: RS1 84.298 gives 110.20; ADAMS {P['adams_travel_mm']:g}, "
                          f"test {P['test_travel_mm']:g}"),
-        F("towing_grazing_span_deg", "G1 tip land grazes S2 at zero clearance for",
+        F("towing_grazing_span_deg", f"{stop_phrase(g, tow.last_pusher)} at zero clearance for"
+          if tow.last_pusher else "tip land grazes the stop corner at zero clearance for",
           _deg(tow.grazing_end_rad - tow.disengage_rad), "deg",
-          note="S2 lies on the RS1 circle by design"),
+          note=beyond or ("S2 lies on the RS1 circle by design" if tow.last_pusher == (first_j, first_k)
+                          else "the stop corner lies on the tip circle that passes over it")),
         F("reengage_angle_deg", "return swing picks the rack up at", _deg(tow.reengage_rad), "deg",
           note=beyond or "S6 met by the next tooth's trailing flank"),
         F("towing_travel_mm_at_068deg", "towing curve L(68°)", travel_at(68.0), "mm"),
@@ -153,6 +157,28 @@ def calc(params: Params) -> list[Figure]:
         F("ddisengage_dRS1_deg_per_mm", "sensitivity dφ(disengage)/dRS1", dphi_drs1, "deg/mm", digits=2),
         F("dphiS6_dhS6_deg_per_mm", "sensitivity dφS6/dhS6", dphi_dhs6, "deg/mm", digits=2),
     ]
+    # A solved trim the model has no value for is left out (no null in calc --json); the table says
+    # so beside the solved L(S3/S4), which the solver starts from.
+    none = [f"{name}: none in range ({why})" for key, name, why in (
+        ("RS1_solved_mm", "RS1 solved", "no RS1 up to Ra reaches the target"),
+        ("hS2_solved_mm", "hS2 solved", "no hS2 up to the rack top gives equal travel"))
+        if not math.isfinite(next(f.value for f in figures if f.key == key))]
+    figures = [dataclasses.replace(f, note="; ".join(none)) if f.key == "travel_S3S4_solved_mm" and none else f
+               for f in figures
+               if not (f.key in ("RS1_solved_mm", "hS2_solved_mm") and not math.isfinite(f.value))]
     if an.is_paper_design(params):
         return figures
-    return [dataclasses.replace(f, paper=None) for f in figures]  # another design: no printed targets
+    # another design: no printed targets, no notes about the paper's figures, no sample at ADAMS's angle
+    keep = {"contact_ratio", "continuous_margin_deg", "towing_max_overlap_mm", "towing_grazing_span_deg",
+            "travel_S3S4_solved_mm", "reengage_angle_deg"}
+    out = []
+    for f in figures:
+        if f.key == "towing_travel_mm_at_adams_angle":
+            continue
+        note = f.note
+        if f.key == "continuous_angle_deg":
+            note = drive.event
+        elif f.key not in keep and note != beyond:
+            note = ""
+        out.append(dataclasses.replace(f, paper=None, note=note))
+    return out

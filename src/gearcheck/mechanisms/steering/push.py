@@ -259,6 +259,7 @@ class Towing:
     travel_at_disengage_mm: float
     grazing_end_rad: float  # the last pusher stops touching the standing rack (forward)
     reengage_rad: float  # a tooth picks the rack up again (return)
+    last_pusher: tuple[int, int] | None = None  # (j, k) of the pair that pushed last (forward), if it stops
 
 
 def towing_grid(max_angle_deg: float, step_deg: float = ANGLE_STEP_DEG, extra_deg=CHECK_ANGLES_DEG) -> np.ndarray:
@@ -284,6 +285,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
     end = float(fwd.travel_mm[-1])
     moving_late = end - np.interp(phis[-1] - math.radians(1.0), phis, fwd.travel_mm) > TRAVEL_TOL_MM
     dis = graze = math.nan
+    last: tuple[int, int] | None = None
     if not moving_late:
         i = int(np.argmax(fwd.travel_mm >= end - TRAVEL_TOL_MM))
         if i > 0:
@@ -295,6 +297,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
         # the pair that pushed last, and where it stops touching
         n = int(np.nanargmin(np.abs(np.where(np.isfinite(fwd.hi[:, i]), fwd.hi[:, i] - end, np.inf))))
         j, k = fwd.pairs[n]
+        last = (j, k)
 
         def apart(p: float) -> bool:
             hi = pair_push_interval(g, j, k, [p], +1)[1][0]
@@ -315,7 +318,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
         i = int(np.argmax(moved))
         re = _bisect(lambda p: _travel_after(g, p, end, -1, back_phis[i - 1]) < end - TRAVEL_TOL_MM,
                      back_phis[i - 1], back_phis[i])
-    return Towing(fwd, back, dis, end if math.isfinite(dis) else math.nan, graze, re)
+    return Towing(fwd, back, dis, end if math.isfinite(dis) else math.nan, graze, re, last)
 
 
 def travel_on_curve(t: Towing, phi: float) -> float:

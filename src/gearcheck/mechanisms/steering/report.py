@@ -3,6 +3,7 @@ findings in words, from the sweep's outcome."""
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Sequence
 
 import numpy as np
@@ -22,7 +23,18 @@ def report(params, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report
     """sweep.csv rows (made by the reduce), comparisons, plots and notes."""
     data: SteeringSweep = outcome.data
     paper = paper_figures(params)
-    return Report(data.rows, _comparisons(paper, data), _plots(paper, data), _notes(paper, data))
+    comparisons = _comparisons(paper, data)
+    if paper["disengage_deg"] is None:  # another design: no printed figures, no rows only about them
+        comparisons = [c if not any(w in c.note for w in ("paper", "ADAMS", "S1 rounded")) else
+                       dataclasses.replace(c, note="")
+                       for c in comparisons if not any(w in c.label for w in ("ADAMS", "test"))]
+    return Report(data.rows, comparisons, [_drop_none(p) for p in _plots(paper, data)], _notes(paper, data))
+
+
+def _drop_none(plot: Plot) -> Plot:
+    """Markers and lines without a value (the paper's, beside another design) are left out."""
+    return dataclasses.replace(plot, markers=[m for m in plot.markers if m[1] is not None],
+                               hlines=[h for h in plot.hlines if h[1] is not None])
 
 
 def _comparisons(P: dict, data: SteeringSweep) -> list[Comparison]:
@@ -44,12 +56,21 @@ def _comparisons(P: dict, data: SteeringSweep) -> list[Comparison]:
                    f"at ADAMS's own angle the mesh curve gives {travel_at_adams:.3f}"),
         Comparison("rack travel at disengage, test", "mm", P["test_travel_mm"], model.stand_mm, stand,
                    "test rig: backlash and deflection"),
-        Comparison("G1's tip land grazes S2 for", "deg", None, model.graze_deg, plus["geom_grazing_span_deg"],
-                   "S2 lies on the RS1 circle by design (2·β(RS1))"),
+        Comparison(f"{model.stop_by} for", "deg", None, model.graze_deg, plus["geom_grazing_span_deg"],
+                   "S2 lies on the RS1 circle by design (2·β(RS1))" if model.stop_by.startswith("G1")
+                   else "the corner lies on the tip circle that passes over it"),
         Comparison("re-engage angle (return swing picks the rack up)", "deg", None, model.reengage_deg,
                    plus["geom_reengage_angle_deg"], "next tooth's trailing flank meets S6; the paper prints no value"),
         Comparison("continuous drive (power mode, contact reaches S6), theory", "deg", P["phi_S6_deg"],
                    model.continuous_deg, cont, "paper used hS6 = 25.38 from its own lines (62.10° with it)"),
+        Comparison("continuous drive, towing (every hand-over; mesh: rack falls a contact tolerance behind r·φ)",
+                   "deg", None, model.towing_drive_deg, plus["geom_towing_conjugate_end_deg"],
+                   f"{model.towing_drive_event}; the mesh figure is grid-limited (linear between poses)"),
+        Comparison("continuous drive, power (every hand-over; mesh: first tooth's contact reaches S6)", "deg", None,
+                   model.power_drive_deg, cont, model.power_drive_event),
+        Comparison("continuous drive, whole drive (least of model and mesh, both directions)", "deg", None,
+                   min(model.towing_drive_deg, model.power_drive_deg), data.least_drive_deg,
+                   "the continuous_drive verdict's figure"),
         Comparison("continuous drive, test", "deg", P["test_continuous_deg"], model.continuous_deg, cont,
                    "test includes backlash and deflection"),
         Comparison("raw FCL nearest point reaches S6 (diagnostic)", "deg", None, model.power_limit_deg,
@@ -111,17 +132,26 @@ def _notes(P: dict, data: SteeringSweep) -> list[str]:
     printed = (f"; paper {P['disengage_deg']}°/{P['travel_disengage_mm']} theory, {P['adams_disengage_deg']}°/"
                f"{P['adams_travel_mm']} ADAMS, {P['test_disengage_deg']:g}°/{P['test_travel_mm']} test"
                if P["disengage_deg"] is not None else "")
+    if model.moving_at_end or not plus["geom_rack_motion_last_degree_mm"] <= data.tol:
+        stop = [f"Towing: the rack is still moving at the end of the swing (it moved "
+                f"{plus['geom_rack_motion_last_degree_mm']:.3f} mm over the last degree): no disengage within "
+                "towing.max_angle_deg."]
+    else:
+        stop = [
+            f"Towing: the rack stops at +{plus['geom_disengage_angle_deg']:.3f}° / "
+            f"−{minus['geom_disengage_angle_deg']:.3f}° at {plus['geom_rack_travel_at_disengage_mm']:.3f} mm "
+            f"(model {model.disengage_deg:.3f}°, {model.stand_mm:.3f} mm{printed}).",
+            f"Past the stop {model.stop_by} (closest {plus['graze_distance_mm']:.2e} mm at "
+            f"{plus['graze_angle_deg']:.2f}°; the rack reaches contact {plus['graze_contact_shift_mm']:.5f} mm "
+            f"further back) for {plus['geom_grazing_span_deg']:.2f}° (model {model.graze_deg:.2f}°); the standing "
+            f"rack creeps ≤ {plus['geom_rack_motion_after_disengage_mm']:.4f} mm as the tip land's chord vertices "
+            f"pass {model.stop_by.rsplit(' ', 1)[-1]}.",
+        ]
     return [
         f"Contact tolerance {data.tol:.3f} mm (≥ the meshes' error bound {data.bound:.3f} mm): zero-backlash flanks "
         "touch at zero clearance, so a collision is measured (the rack shift that clears it) and accepted up to this "
         "depth.",
-        f"Towing: the rack stops at +{plus['geom_disengage_angle_deg']:.3f}° / "
-        f"−{minus['geom_disengage_angle_deg']:.3f}° at {plus['geom_rack_travel_at_disengage_mm']:.3f} mm "
-        f"(model {model.disengage_deg:.3f}°, {model.stand_mm:.3f} mm{printed}).",
-        f"Past the stop G1's tip land grazes S2 (closest {plus['graze_distance_mm']:.2e} mm at "
-        f"{plus['graze_angle_deg']:.2f}°; the rack reaches contact {plus['graze_contact_shift_mm']:.5f} mm further "
-        f"back) for {plus['geom_grazing_span_deg']:.2f}° (model {model.graze_deg:.2f}°); the standing rack creeps ≤ "
-        f"{plus['geom_rack_motion_after_disengage_mm']:.4f} mm as the tip land's chord vertices pass S2.",
+        *stop,
         f"The return swing picks the rack up at {plus['geom_reengage_angle_deg']:.3f}° "
         f"(model {model.reengage_deg:.3f}°).",
         f"Power mode: the contact reaches S6 at {plus['geom_continuous_angle_deg']:.3f}° / "

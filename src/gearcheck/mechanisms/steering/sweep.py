@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
+from gearcheck.geometry.rack_pinion_contact import stop_phrase, whole_drive
 from gearcheck.geometry.rack_pinion_power import power_model_travel
 from gearcheck.mechanism import Assembly, SweepPlan, Task
 from gearcheck.mechanisms.steering import analysis as an
@@ -61,13 +62,24 @@ class ModelFigures:
     continuous_deg: float  # min(towing S1, power S6)
     power_limit_deg: float  # S6 (eq 19)
     s1_deg: float  # towing conjugate end (eq 17)
+    # whole drive from the exact contact intervals of every tooth pair (rack_pinion_contact)
+    towing_drive_deg: float = math.nan
+    towing_drive_event: str = ""
+    power_drive_deg: float = math.nan
+    power_drive_event: str = ""
+    contact_ratio: float = math.nan  # ε at the machined hS4 (eqs 1-2)
+    stop_by: str = "G1's tip land grazes S2"  # past the stop, named by the pair that pushed last
+    moving_at_end: bool = False  # the rack is still moving at the end of the towing swing
 
     @classmethod
     def of(cls, g: RackPinionGeometry, tow: an.Towing) -> ModelFigures:
         deg = math.degrees
+        towing, power = whole_drive(g)
         return cls(deg(tow.disengage_rad), tow.travel_at_disengage_mm, deg(tow.grazing_end_rad - tow.disengage_rad),
                    deg(tow.reengage_rad), deg(min(an.continuous_towing_angle(g), an.continuous_power_angle(g))),
-                   deg(an.continuous_power_angle(g)), deg(an.phi_towing_conjugate_end(g, g.sector_first_tooth)))
+                   deg(an.continuous_power_angle(g)), deg(an.phi_towing_conjugate_end(g, g.sector_first_tooth)),
+                   towing.angle_deg, towing.event, power.angle_deg, power.event,
+                   an.contact_ratio(g, g.hS4_mm), stop_phrase(g, tow.last_pusher), math.isnan(tow.disengage_rad))
 
 
 @dataclass(frozen=True)
@@ -88,6 +100,7 @@ class SteeringSweep:
     mesh_info: dict
     speed: dict
     travel_at_adams_mm: float  # mesh towing travel at the grid angle nearest ADAMS's disengage
+    least_drive_deg: float = math.nan  # continuous_drive_deg: least of the model and the mesh
 
 
 def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None = None
@@ -138,8 +151,10 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
               for d, m in ((+1, np.ones(2)), (-1, mirror))]
     weights = [2 * len(angles)] * 2 + [len(travels)] * 2  # poses per task
 
+    paper = an.is_paper_design(params)
+
     def reduce(results: list) -> SweepOutcome:
-        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start)
+        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper)
 
     return SweepPlan(meshes, tasks, reduce, weights, "pose", opts)
 
@@ -192,10 +207,28 @@ def _power_rows(g: RackPinionGeometry, power: dict) -> tuple[list[dict], dict]:
     return rows, deviation
 
 
-def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float) -> dict:
+def towing_conjugate_end(g: RackPinionGeometry, r: dict, tol: float) -> float:
+    """Mesh towing (one direction): the first pinion angle (rad, magnitude) at which the rack falls
+    more than ``tol`` behind conjugate travel r·φ on the forward swing, linear between grid poses:
+    where the mesh's continuous towing drive ends, to within the grid and the contact tolerance."""
+    out = np.abs(r["angles_out"])
+    lag = g.pitch_radius * out - np.abs(r["travel_out"]) - tol
+    over = np.flatnonzero(lag > 0.0)
+    if not over.size:
+        return float(out[-1])
+    i = int(over[0])
+    if i == 0:
+        return float(out[0])
+    a0, a1, l0, l1 = out[i - 1], out[i], lag[i - 1], lag[i]
+    return float(a0 + (a1 - a0) * (-l0) / (l1 - l0))
+
+
+def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, towing_end: float) -> dict:
     """Geometry figures of one direction (angle and travel magnitudes)."""
     deg = math.degrees
     out = r["angles_out"]
+    mag, travel = np.abs(out), np.abs(r["travel_out"])
+    last_degree = float(travel[-1] - np.interp(mag[-1] - math.radians(1.0), mag, travel))
     i_dis = int(np.searchsorted(np.abs(out), abs(r["disengage"]))) if math.isfinite(r["disengage"]) else len(out)
     past = r["clearance_out"][i_dis:]
     w = r["worst"]
@@ -212,6 +245,10 @@ def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float) ->
         "geom_continuous_angle_deg": abs(deg(p["limit_angle"])),
         "geom_rack_travel_at_continuous_limit_mm": abs(p["limit_travel"]),
         "geom_raw_corner_contact_angle_deg": abs(deg(p["raw_corner_angle"])),
+        "geom_towing_conjugate_end_deg": deg(towing_end),
+        # the rack still moving at the end of the swing: it moved more than the contact tolerance
+        # over the last degree of the forward swing (no disengage within towing.max_angle_deg)
+        "geom_rack_motion_last_degree_mm": last_degree,
         "max_towing_curve_deviation_mm": towing_dev,
         "max_power_curve_deviation_mm": power_dev,
         "min_signed_clearance_mm": float(min(np.min(r["clearance_out"]), np.min(r["clearance_back"]),
@@ -224,8 +261,14 @@ def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float) ->
     }
 
 
+def _least(*values: float) -> float:
+    """The least finite value (NaN when there is none)."""
+    finite = [v for v in values if math.isfinite(v)]
+    return min(finite) if finite else math.nan
+
+
 def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results: list, tol: float, bound: float,
-            mesh_info: dict, t_start: float) -> SweepOutcome:
+            mesh_info: dict, t_start: float, paper: bool = True) -> SweepOutcome:
     P = an.PAPER
     tow = {r["direction"]: r for r in results[:2]}
     power = {r["direction"]: r for r in results[2:]}
@@ -234,7 +277,8 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     rows, towing_dev, curves = _towing_rows(g, tow)
     power_rows, power_dev = _power_rows(g, power)
     rows += power_rows
-    plus, minus = (_direction_summary(tow[d], power[d], towing_dev[d], power_dev[d]) for d in (+1, -1))
+    plus, minus = (_direction_summary(tow[d], power[d], towing_dev[d], power_dev[d],
+                                      towing_conjugate_end(g, tow[d], tol)) for d in (+1, -1))
     queries = sum(r["queries"] for r in results)
     speed = {"poses": len(rows), "fcl_queries": queries, "elapsed_s": elapsed, "poses_per_s": len(rows) / elapsed,
              "fcl_queries_per_s": queries / elapsed, "task_seconds": [float(r["seconds"]) for r in results],
@@ -255,6 +299,12 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "model_grazing_span_deg": model.graze_deg,
         "model_reengage_angle_deg": model.reengage_deg,
         "model_continuous_angle_deg": model.continuous_deg,
+        "model_continuous_towing_deg": model.towing_drive_deg,
+        "model_continuous_power_deg": model.power_drive_deg,
+        "continuous_drive_deg": _least(model.towing_drive_deg, model.power_drive_deg,
+                                      *(s["geom_continuous_angle_deg"] for s in (plus, minus)),
+                                      *(s["geom_towing_conjugate_end_deg"] for s in (plus, minus))),
+        "model_contact_ratio": model.contact_ratio,
         "paper_continuous_angle_deg": P["phi_S6_deg"],
         "paper_test_continuous_angle_deg": P["test_continuous_deg"],
         "max_towing_curve_deviation_mm": max(towing_dev.values()),
@@ -266,14 +316,18 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "fcl_queries": speed["fcl_queries"],
         **mesh_info,
     }
+    if not paper:  # the paper's printed figures stand only beside the paper's own design
+        summary = {k: v for k, v in summary.items() if not k.startswith("paper_")}
 
     out_deg = np.degrees(tow[1]["angles_out"])
     travel_at_adams = float(tow[1]["travel_out"][int(np.argmin(np.abs(out_deg - P["adams_disengage_deg"])))])
+    over = model.stop_by.replace(" grazes ", " over ")
     worst_poses = [
-        WorstPose(f"towing {sign(d)}: closest approach past the disengage (G1's tip land over S2)", PINION, RACK,
+        WorstPose(f"towing {sign(d)}: closest approach past the disengage ({over})", PINION, RACK,
                   kin.pinion(w["angle"]).tolist(), kin.rack(w["travel"]).tolist(), float(w["distance"]))
         for d in (+1, -1) if (w := tow[d]["worst"])
     ]
-    data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams)
+    data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
+                         summary["continuous_drive_deg"])
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}
     return SweepOutcome(summary, worst_poses, None, timings, data)

@@ -12,7 +12,7 @@ import math
 
 from gearcheck.figures import Figure
 from gearcheck.geometry import iso606
-from gearcheck.mechanisms.track import analysis
+from gearcheck.mechanisms.track import analysis, wear
 from gearcheck.mechanisms.track.params import Params
 
 # Meshing tolerance when --tol is not given: the mesh-error bound must stay within 1/10 of the
@@ -27,6 +27,48 @@ PAPER = {
     "tip_diameter_mm": 235.0,
     "max_drive_force_N": 234.0,
 }
+# The paper's own design: the inputs each printed value depends on. A printed value (and a note
+# about it) is shown only beside a design whose inputs match: at another pitch, tooth count or
+# load the paper's number is not a value of that design.
+PAPER_INPUTS = {
+    "chain.pitch_mm": 30.0,
+    "chain.sleeve_diameter_mm": 8.0,
+    "sprocket.teeth": 49,
+    "sprocket.initial_pitch_diameter_mm": 230.0,
+    "sprocket.tip_over_pitch_mm": 0.4,
+    "robot.mass_kg": 150.0,
+    "robot.tracks": 4,
+    "ground.adhesion_coefficient": 0.7,
+    "ground.rolling_resistance_coefficient": 0.08,
+}
+PAPER_DEPENDS = {
+    "teeth_for_initial_pitch_diameter": ("chain.pitch_mm", "sprocket.initial_pitch_diameter_mm"),
+    "pitch_diameter_mm": ("chain.pitch_mm", "sprocket.teeth"),
+    "root_diameter_mm": ("chain.pitch_mm", "sprocket.teeth", "chain.sleeve_diameter_mm"),
+    "tip_diameter_mm": ("chain.pitch_mm", "sprocket.teeth", "sprocket.tip_over_pitch_mm"),
+    # g is not among them: the paper's g = 10 is a reading, and 9.81 is shown against its 234 N
+    "max_drive_force_N": ("robot.mass_kg", "robot.tracks", "ground.adhesion_coefficient",
+                          "ground.rolling_resistance_coefficient"),
+}
+
+
+def _input(params: Params, dotted: str) -> float:
+    section, field = dotted.split(".")
+    return float(getattr(getattr(params, section), field))
+
+
+def paper_design(params: Params, key: str | None = None) -> bool:
+    """Whether the inputs behind the paper's printed value ``key`` (all of them without a key)
+    are the paper's own."""
+    names = PAPER_DEPENDS[key] if key is not None else tuple(PAPER_INPUTS)
+    return all(math.isclose(_input(params, n), float(PAPER_INPUTS[n]), rel_tol=1e-12, abs_tol=1e-12)
+               for n in names)
+
+
+def odd_round_up(x: float) -> int:
+    """The smallest odd whole number ≥ x (the paper rounds its 48.03 up to the odd 49)."""
+    n = math.ceil(x - 1e-9)
+    return n if n % 2 else n + 1
 
 # Outline sampling for the independent tip-gap measurement; corners are exact vertices anyway.
 GAP_CHECK_STEP_MM = 0.05
@@ -37,16 +79,23 @@ def _verdict(ok: bool) -> tuple[float, str]:
 
 
 class _Figures(list):
-    """The figures in table order; ``add`` attaches the paper's value where it has one."""
+    """The figures in table order; ``add`` attaches the paper's value where it has one and the
+    design's inputs behind it are the paper's own (:func:`paper_design`)."""
+
+    def __init__(self, params: Params):
+        super().__init__()
+        self.params = params
 
     def add(self, key, label, value, unit, note="", digits=3):
-        self.append(Figure(key, label, float(value), unit, PAPER.get(key), note, digits))
+        paper = PAPER.get(key) if key in PAPER and paper_design(self.params, key) else None
+        self.append(Figure(key, label, float(value), unit, paper, note, digits))
 
 
 def calc(params: Params) -> list[Figure]:
-    F = _Figures()
+    F = _Figures(params)
     d, gap, lim = _geometry(params, F.add)
     _plate(params, F.add, gap)
+    _wear(params, F.add, gap)
     drive, design = _loads(params, F.add, d)
     _pin(params, F.add, drive)
     _crush(params, F.add, design, lim)
@@ -62,8 +111,11 @@ def _geometry(params: Params, add):
     df = d - dr
     de = d + sp.tip_over_pitch_mm
     chord = iso606.groove_chord(d, z)
+    z_up = odd_round_up(z_initial)
+    z_note = (f"rounded up to the odd z = {z}" if z == z_up
+              else f"template z = {z}, not the odd round-up {z_up} of this estimate")
     add("teeth_for_initial_pitch_diameter", f"z for d = {sp.initial_pitch_diameter_mm:g} mm (eq. 6 inverted)",
-        z_initial, "", f"rounded to odd z = {z}", 2)
+        z_initial, "", z_note, 2)
     add("pitch_diameter_mm", "pitch diameter d = p/sin(360°/z)", d, "mm", "every other tooth engages", 2)
     add("root_diameter_mm", "root diameter df = d − dR", df, "mm", digits=2)
     add("tip_diameter_mm", "tip diameter de = d + tip rule", de, "mm",
@@ -121,6 +173,17 @@ def _plate(params: Params, add, gap) -> None:
     add("tip_gap_ok", "tip gap within the paper's window (1 = pass)", ok, "", word, 0)
 
 
+def _wear(params: Params, add, gap) -> None:
+    """Chain wear: the declared pitch growth and the closed-form limit of the tip mode (the sleeve
+    of the worn chain, on R·(1 + e), touching its driving flank at the tip corner)."""
+    declared = params.chain.wear_elongation_pct
+    limit = 100.0 * wear.tip_limit_closed_form(gap, params.chain.sleeve_diameter_mm / 2.0)
+    add("wear_elongation_pct", "declared chain wear (pitch growth)", declared, "%", "chain.wear_elongation_pct")
+    add("wear_limit_tip_pct", "wear at which the flank contact reaches the tip corner", limit, "%",
+        f"{'pass' if declared <= limit else 'FAIL'}: closed form; `check` bisects the exact 2-D model "
+        "(tip, jump and worn-sweep modes)", 4)
+
+
 def _loads(params: Params, add, d: float) -> tuple[float, float]:
     """Eq. 1: weight, drive force, the design load on one tooth; the slope."""
     r, gr = params.robot, params.ground
@@ -130,8 +193,9 @@ def _loads(params: Params, add, d: float) -> tuple[float, float]:
     normal = weight / r.tracks
     design = max(normal, drive)
     add("weight_N", "robot weight G = m·g", weight, "N", f"g = {r.g_m_s2:g} m/s²", 1)
-    add("max_drive_force_N", "max drive force per track P_Kφ = (φ − f)G/n", drive, "N",
-        "eq. 1 lost: (φ − f)G/n, within 1 % of 234 N at g = 10; no slope term", 1)
+    drive_note = ("eq. 1 lost: (φ − f)G/n, within 1 % of 234 N at g = 10; no slope term"
+                  if paper_design(params, "max_drive_force_N") else "eq. 1 lost: (φ − f)G/n; no slope term")
+    add("max_drive_force_N", "max drive force per track P_Kφ = (φ − f)G/n", drive, "N", drive_note, 1)
     add("normal_load_per_track_N", "normal load per track G/n", normal, "N", "level ground (largest)", 1)
     add("design_load_N", "design load F = max(G/n, P_Kφ), one tooth", design, "N", digits=1)
     need = analysis.required_adhesion(r.slope_deg, gr.rolling_resistance_coefficient)
@@ -145,7 +209,12 @@ def _loads(params: Params, add, d: float) -> tuple[float, float]:
         analysis.climb_force_needed_N(r.mass_kg, r.g_m_s2, r.slope_deg, gr.rolling_resistance_coefficient,
                                       r.tracks), "N", "G(sin α + f cos α)/n", 1)
     add("slope_climbable", "slope climbable by adhesion (1 = pass)", ok, "", word, 0)
-    add("sprocket_speed_rpm", "sprocket speed at v", r.speed_m_s * 60_000.0 / (math.pi * d), "rpm", digits=1)
+    advance = analysis.chain_advance_per_turn_mm(params.chain.pitch_mm, params.sprocket.teeth)
+    rpm_pi_d = r.speed_m_s * 60_000.0 / (math.pi * d)
+    rpm = r.speed_m_s * 60_000.0 / advance
+    add("sprocket_speed_rpm", "sprocket speed at v, v/(z·p/2)", rpm, "rpm",
+        f"chain advances z/2 links = {advance:.2f} mm per turn (every other tooth engages); "
+        f"v/(π·d) would give {rpm_pi_d:.2f} ({100 * (rpm_pi_d / rpm - 1):+.2f} %)", 1)
     add("drive_torque_per_track_Nm", "sprocket torque at P_Kφ", drive * d / 2000.0, "N·m", digits=2)
     add("drive_power_per_track_W", "drive power per track P_Kφ·v", drive * r.speed_m_s, "W", digits=0)
     return drive, design
@@ -193,4 +262,4 @@ def _crush(params: Params, add, design: float, lim) -> None:
     add("crush_ok", "crush stress (1 = pass)", ok, "", word, 0)
 
 
-__all__ = ["MESH_TOL_MM", "PAPER", "Params", "calc"]
+__all__ = ["MESH_TOL_MM", "PAPER", "PAPER_INPUTS", "Params", "calc", "paper_design"]

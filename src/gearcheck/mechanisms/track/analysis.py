@@ -87,6 +87,14 @@ def hertz_line_contact(
     return HertzLine(p0, a)
 
 
+def chain_advance_per_turn_mm(pitch_mm: float, teeth: int) -> float:
+    """Chain travel per sprocket revolution, z·p/2: every other tooth engages, so a link spans
+    two of the z grooves and z/2 links pass per turn (an odd z averages over two turns). Not π·d:
+    the pins move on the pin circle d but the chain between them is a chord, shorter than the arc
+    by the factor sin(2π/z)/(2π/z) (0.27 % at z = 49)."""
+    return teeth * pitch_mm / 2.0
+
+
 def link_pin_line_radius(gap: iso606.ToothGap) -> float:
     """Distance from the sprocket axis to a seated link's pin line at mid-span, R·cos(360°/z)."""
     return gap.pitch_radius_mm * math.cos(2.0 * gap.half_pitch_angle_rad)

@@ -36,6 +36,7 @@ class TrackModel:
     tip_gap_mm: float  # template input: the gap the plate offset was solved for
     required_gap_min_mm: float
     required_gap_max_mm: float
+    wear_elongation: float = 0.0  # declared pitch growth by wear (fraction), chain.wear_elongation_pct / 100
 
     @property
     def sleeve_radius_mm(self) -> float:
@@ -45,6 +46,10 @@ class TrackModel:
         g, w = self.gap, self.wrap
         return (g.teeth, g.pitch_radius_mm, g.seating_radius_mm, g.flank_radius_mm, g.seating_angle_rad,
                 g.tip_radius_mm, self.link, w)
+
+    def section_key(self) -> tuple:
+        """What the exact 2-D section depends on (not the wrap): the groove and the link."""
+        return self.key()[:-1]
 
     @property
     def seating_clearance_mm(self) -> float:
@@ -61,7 +66,7 @@ def track_assembly(params) -> Assembly:
     lay = layout.track_layout(params)
     tp = params.track_plate
     model = TrackModel(lay.sprocket.gap, lay.wrap, lay.link, tp.tip_gap_mm, tp.required_gap_min_mm,
-                       tp.required_gap_max_mm)
+                       tp.required_gap_max_mm, params.chain.wear_elongation_pct / 100.0)
     poses = lay.wrap.link_matrices(0.0)
     parts = [PartSpec(SPROCKET, SPROCKET, SPROCKET_MATERIAL, tc.sprocket_matrix(0.0), SPROCKET_COLOR,
                       Rotation.about((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)))]

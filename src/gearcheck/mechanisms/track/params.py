@@ -52,6 +52,12 @@ class Chain(Section):
                                     description="b2: span of a pin segment between its supports [b2]")
     pin_segments: int = _f(1, 8, description="pin segments, each a simply supported beam (one per tooth row)")
     track_width_mm: float = _f(gt=0, hi=2000, unit="mm", description="track width")
+    wear_elongation_pct: float = Field(
+        1.5, ge=0, le=25, json_schema_extra={"unit": "%"},
+        description="pitch growth by wear the drive must tolerate, in % of p (sprocket unchanged, every link "
+                    "p·(1 + e)); default 1.5 %: the usual roller-chain replacement point for drives with up to "
+                    "60 teeth (maker practice, e.g. Tsubaki, FB Chain), half the 3 % ceiling of ANSI B29.1 / "
+                    "ISO 606 practice; see docs/track.md")
 
 
 class Sprocket(Section):

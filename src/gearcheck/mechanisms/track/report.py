@@ -8,6 +8,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from gearcheck.mechanisms.track.sweep import TrackSweep, finite, rowmin
+from gearcheck.mechanisms.track.wear import MODE_TEXT
 from gearcheck.results import Comparison, Plot, Report, Series, SweepOutcome, Verdict
 
 
@@ -56,6 +57,39 @@ def comparisons(d: TrackSweep) -> list[Comparison]:
         Comparison("closest sampled tooth–sleeve clearance of sleeves off their seats", "mm", None, None,
                    finite(x["off_sleeve"].value), "approaching / leaving: falls steadily to ri − R as the pin seats",
                    exact=finite(x["ex_off_sleeve"].value)),
+        *_wear_comparisons(d),
+    ]
+
+
+def _wear_comparisons(d: TrackSweep) -> list[Comparison]:
+    w = d.wear
+    if w is None:
+        return []
+    return [Comparison("chain wear: declared elongation vs the limit at which a link first fails to seat", "%",
+                       None, 100.0 * w.declared, None,
+                       f"limit: {MODE_TEXT[w.mode]}; exact 2-D model (the mesh sweep confirms the worn wrap's "
+                       "clearances at the declared wear)",
+                       exact=100.0 * w.limit)]
+
+
+def _wear_notes(d: TrackSweep) -> list[str]:
+    w = d.wear
+    if w is None:
+        return []
+    seat, sweep = w.declared_seat, w.declared_sweep
+    at_declared = (f"the driving-flank contact at radius {seat.contact_radius_mm:.4f} mm (tip circle "
+                   f"{d.model.gap.tip_radius_mm:.4f} mm)" if seat.ok else f"the sleeve fails: {MODE_TEXT[seat.mode]}")
+    return [
+        f"Chain wear: every link pitch p·(1 + e), the sprocket unchanged, the pins on the larger circle "
+        f"R·(1 + e). Limit {100 * w.limit:.4f} % (bisection bracket {100 * w.limit:.5f}–"
+        f"{finite(100 * w.fail_at):.5f} %; {MODE_TEXT[w.mode]}); declared {100 * w.declared:.3f} %: "
+        f"{at_declared}; the worn chain re-wrapped at p' and swept over {sweep.poses} poses × {sweep.links} links "
+        f"keeps sleeves ≥ {finite(sweep.min_sleeve_mm):.4f} mm and plates ≥ {finite(sweep.min_plate_mm):.4f} mm "
+        "from the outline. The exact 2-D model decides the seat (where the driving-flank contact lies); "
+        + (f"the mesh sweep confirms the worn wrap: the same link meshes posed at p' over {d.worn_mesh.poses} poses, "
+           f"{d.worn_mesh.collisions} collisions, min tooth–sleeve {d.worn_mesh.min_sleeve_mm:.4f} mm, min "
+           f"tip–plate {d.worn_mesh.min_plate_mm:.4f} mm, |mesh − exact| ≤ {d.worn_mesh.max_dev:.4f} mm."
+           if d.worn_mesh is not None else "no worn-pitch mesh sweep at zero declared wear."),
     ]
 
 
@@ -114,6 +148,7 @@ def notes(d: TrackSweep) -> list[str]:
         f"[{sleeve_proof.free_mm:.6f}, {sleeve_proof.touching_mm:.6f}] mm (ri − R = {model.seating_clearance_mm:.4f}).",
         f"Exact 2-D model (ISO 606 outline at {d.outline_step_mm} mm, no mesh): largest |mesh − exact| "
         f"over all {n_poses * wrap.links} link poses {d.max_dev:.4f} mm (bound {d.bound:.3f} mm).",
+        *_wear_notes(d),
         f"Speed: {n_poses} poses ({n_poses * wrap.links} link poses, each 2 FCL distances, 1 FCL collision and "
         f"the exact 2-D distances) in {d.sweep_s:.2f} s = {n_poses / d.sweep_s:.0f} poses/s; contact proofs "
         f"{d.proof_s:.2f} s.",

@@ -24,6 +24,7 @@ this process.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 import time
@@ -38,6 +39,7 @@ from gearcheck.geometry import track_chain as tc
 from gearcheck.geometry.track_section import ExactSection
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
+from gearcheck.mechanisms.track import wear as track_wear
 from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
 from gearcheck.results import Clearance, SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
@@ -96,7 +98,7 @@ _EXACT_CACHE: dict = {}
 
 def exact_section(model: TrackModel) -> ExactSection:
     """One exact model per process and template (workers receive the model with every pose)."""
-    key = model.key()
+    key = model.section_key()
     if key not in _EXACT_CACHE:
         _EXACT_CACHE.clear()
         _EXACT_CACHE[key] = ExactSection(model.gap, model.link)
@@ -136,6 +138,7 @@ class _Setup:
     contact_tol: float
     angles: np.ndarray
     started: float
+    worn_model: TrackModel | None = None  # the same chain re-wrapped at the declared worn pitch
 
 
 def link_names(assembly: Assembly) -> list[str]:
@@ -165,7 +168,16 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     bound = pair_error_bound(dict(bodies), SPROCKET, names[0])
     angles = sweep_angles(model.wrap, int(opts["steps_per_cycle"]), float(opts["margin_fraction"]))
     tasks = [(evaluate_pose, (model, float(a))) for a in angles]
-    setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter())
+    # the declared chain wear: the same link solids posed by the worn wrap (pins p·(1 + e) apart),
+    # at the same angles, confirm the exact model's worn-pitch sweep on the meshes
+    worn_model = None
+    if model.wear_elongation > 0.0:
+        w = model.wrap
+        worn_model = dataclasses.replace(model, wrap=track_wear.worn_wrap(w.teeth, w.pitch_mm,
+                                                                          model.wear_elongation, w))
+        tasks += [(evaluate_pose, (worn_model, float(a))) for a in angles]
+    setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter(),
+                   worn_model)
     return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts)
 
 
@@ -225,6 +237,8 @@ class TrackSweep:
     sagitta_mm: float
     sweep_s: float
     proof_s: float
+    wear: track_wear.WearLimit | None = None  # the chain-wear limit (exact 2-D model), see :mod:`.wear`
+    worn_mesh: WornMesh | None = None  # the mesh sweep of the chain at the declared worn pitch
 
     @property
     def collisions(self) -> int:
@@ -317,13 +331,37 @@ def _proofs(setup: _Setup, x: dict, sleeve_seated: np.ndarray) -> dict:
             "s_pl": s_pl, "pose_pl": pose_pl, "proof_s": proof_s}
 
 
+@dataclass(frozen=True)
+class WornMesh:
+    """The mesh sweep of the chain at the declared worn pitch, against the exact 2-D model."""
+
+    poses: int
+    collisions: int
+    min_sleeve_mm: float
+    min_plate_mm: float
+    exact_min_sleeve_mm: float
+    exact_min_plate_mm: float
+    max_dev: float
+
+
+def _worn_mesh(results: list, reach_mm: float) -> WornMesh | None:
+    if not results:
+        return None
+    out = np.array(results)
+    sleeve_d, plate_d, hits, ex_sleeve, ex_plate = (out[..., k] for k in range(5))
+    dev_sleeve = np.abs(np.where(sleeve_d < reach_mm / 2, sleeve_d - ex_sleeve, 0.0))
+    dev_plate = np.abs(np.where(plate_d < reach_mm / 2, plate_d - ex_plate, 0.0))
+    return WornMesh(len(out), int((hits > 0.5).sum()), float(sleeve_d.min()), float(plate_d.min()),
+                    float(ex_sleeve.min()), float(ex_plate.min()), float(max(dev_sleeve.max(), dev_plate.max())))
+
+
 def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     """Extremes over all poses and links, contact proofs at the worst poses, the summary, the
     worst poses for exact confirmation and the smallest clearance decided on."""
     sweep_s = time.perf_counter() - setup.started
     model, angles, names, bound = setup.model, setup.angles, setup.names, setup.bound
     wrap = model.wrap
-    out = np.array(results)  # (poses, links, 5)
+    out = np.array(results[:len(angles)])  # (poses, links, 5)
     sleeve_d, plate_d, hits = out[..., 0], out[..., 1], out[..., 2] > 0.5
     ex_sleeve, ex_plate = out[..., 3], out[..., 4]
     exact = exact_section(model)
@@ -351,7 +389,9 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     data = TrackSweep(model, angles, names, sleeve_d, plate_d, hits, ex_sleeve, ex_plate, links_seated,
                       sleeve_seated, x, seated_gap_max, max_dev, bound, setup.contact_tol, gap_proof, sleeve_proof,
                       gap_point_link, float(whole_link_at_sleeve), model_gap, len(setup.meshes[1].faces),
-                      len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s)
+                      len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s,
+                      wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation),
+                      worn_mesh=_worn_mesh(results[len(angles):], exact.reach_mm))
     worst = [
         WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
                   names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),
@@ -431,4 +471,43 @@ def summary(d: TrackSweep) -> dict:
         "seated_links_max": int(seated_counts.max()),
         "min_at_seated_links": int(x["ex_off_plate"].value >= x["ex_seated_gap"].value - WINDOW_ROUNDING_MM
                                    and x["ex_off_sleeve"].value >= x["ex_seated_sleeve"].value - WINDOW_ROUNDING_MM),
+        **({} if d.wear is None else wear_summary(d.wear, d.worn_mesh, d.bound)),
+    }
+
+
+def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: float = 0.0) -> dict:
+    """summary.json's wear figures (exact 2-D model; the mode as its index in ``track_wear.MODES``)
+    and, when the declared wear is above zero, the mesh sweep of the worn chain."""
+    mesh = {} if worn is None else {
+        "mesh_declared_poses": worn.poses,
+        "mesh_declared_collisions": worn.collisions,
+        "mesh_declared_min_sleeve_mm": worn.min_sleeve_mm,
+        "mesh_declared_min_plate_mm": worn.min_plate_mm,
+        "mesh_declared_exact_min_sleeve_mm": finite(worn.exact_min_sleeve_mm),
+        "mesh_declared_exact_min_plate_mm": finite(worn.exact_min_plate_mm),
+        "mesh_declared_max_deviation_mm": worn.max_dev,
+        "mesh_confirms_declared_sweep": int(worn.collisions == 0 and worn.max_dev <= bound
+                                            and min(worn.exact_min_sleeve_mm, worn.exact_min_plate_mm) >= 0.0),
+    }
+    return {
+        "wear_limit_pct": 100.0 * w.limit,
+        "wear_declared_pct": 100.0 * w.declared,
+        "wear_limit_mode": w.mode_code,
+        "wear": {
+            "limit_pct": 100.0 * w.limit,
+            "fail_at_pct": finite(100.0 * w.fail_at),
+            "bisection_tolerance_pct": 100.0 * w.tolerance,
+            "declared_pct": 100.0 * w.declared,
+            "limit_mode": w.mode_code,
+            "limit_mode_tip": int(w.mode == "tip"),
+            "limit_mode_jump": int(w.mode == "jump"),
+            "limit_mode_sweep": int(w.mode == "sweep"),
+            "declared_seats": int(w.declared_seat.ok),
+            "declared_contact_radius_mm": finite(w.declared_seat.contact_radius_mm),
+            "declared_sweep_clear": int(w.declared_sweep.ok),
+            "declared_sweep_min_sleeve_mm": finite(w.declared_sweep.min_sleeve_mm),
+            "declared_sweep_min_plate_mm": finite(w.declared_sweep.min_plate_mm),
+            "decided_by_exact_2d": 1,
+            **mesh,
+        },
     }

@@ -1,12 +1,14 @@
 """The track drive's verdicts: no interference, the seated tip gap inside the paper's window, the
-least tip-to-plate distance over the sweep, contact proven from both sides, and the mesh sweep
-against the exact 2-D model."""
+least tip-to-plate distance over the sweep, contact proven from both sides, the declared chain
+wear within the limit at which a link first fails to seat, and the mesh sweep against the exact
+2-D model."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from gearcheck.mechanisms.track.sweep import WINDOW_ROUNDING_MM, TrackSweep
+from gearcheck.mechanisms.track.wear import MODE_TEXT
 from gearcheck.results import SweepOutcome, Verdict
 
 
@@ -29,7 +31,8 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                      and rounded(d.seated_gap_max) <= model.required_gap_max_mm)
     min_plate_ok = rounded(min_plate.value) >= model.required_gap_min_mm
     proofs_hold = gap_proof.holds(bound) and sleeve_proof.holds(bound)
-    agrees = d.max_dev <= bound
+    worn_dev = d.worn_mesh.max_dev if d.worn_mesh is not None else 0.0
+    agrees = max(d.max_dev, worn_dev) <= bound
     clash = (f"{collisions} colliding link poses, first at θ = {np.degrees(angles[d.colliding_poses[0]]):.3f}°; "
              if collisions else f"FCL collide false at all {len(angles)}×{model.wrap.links} link poses; ")
     resolved = ("a positive clearance beyond the bound" if min_sleeve.value > bound
@@ -59,7 +62,31 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                    {"tip_gap_contact_mm": gap_proof.contact_mm, "tip_gap_measured_mm": gap_proof.measured_mm,
                     "seat_contact_mm": sleeve_proof.contact_mm, "seat_measured_mm": sleeve_proof.measured_mm,
                     "tolerance_mm": d.contact_tol, "bound_mm": bound}),
+        *_wear_verdicts(d),
         Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with the exact 2-D model at every pose and link",
-                   agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm, bound {bound:.3f} mm",
-                   {"max_mesh_deviation_mm": d.max_dev, "bound_mm": bound}),
+                   agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm"
+                   + ("" if d.worn_mesh is None else f" (worn chain: {worn_dev:.4f} mm)") + f", bound {bound:.3f} mm",
+                   {"max_mesh_deviation_mm": d.max_dev, "bound_mm": bound,
+                    **({} if d.worn_mesh is None else {"worn_max_mesh_deviation_mm": worn_dev})}),
     ]
+
+
+def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
+    """The declared chain wear within the limit at which a link first fails to seat."""
+    w = d.wear
+    if w is None:
+        return []
+    seat = "seats" if w.declared_seat.ok else f"does not seat ({MODE_TEXT[w.declared_seat.mode]})"
+    sweep = ("worn-pitch sweep clear" if w.declared_sweep.ok else "worn-pitch sweep meets the sprocket")
+    m = d.worn_mesh
+    mesh = ("" if m is None else
+            f"; mesh sweep of the worn chain: {m.collisions} collisions, min tooth–sleeve {m.min_sleeve_mm:.4f} mm, "
+            f"min tip–plate {m.min_plate_mm:.4f} mm over {m.poses}×{d.model.wrap.links} link poses")
+    return [Verdict.of(
+        "chain_wear_within_limit", "declared chain wear ≤ the elongation at which a link first fails to seat",
+        w.ok and (m is None or m.collisions == 0),
+        f"declared {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % ({MODE_TEXT[w.mode]}; bisection "
+        f"±{100 * w.tolerance:.4f} %); at the declared wear the sleeve {seat}, {sweep} "
+        f"(exact 2-D model){mesh}",
+        {"wear_declared_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
+         "wear_limit_mode": w.mode_code})]

@@ -1,0 +1,200 @@
+"""Track drive: the chain-wear limit (exact 2-D model; the check's verdict with a sweep, cad) and
+the calc labels (the paper's printed values only beside the paper's own design; the sprocket speed
+from the chain's real advance per turn)."""
+
+import json
+import math
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from gearcheck import pipeline
+from gearcheck.cli import main
+from gearcheck.design import load_template
+from gearcheck.mechanism import get
+from gearcheck.mechanisms.track import calc, layout, wear
+from gearcheck.params import ParamError
+
+TEMPLATE = "eod_track_drive"
+# The template's wear limit, found by bisection on e to a bracket of WEAR_BISECTION_TOL = 1e-6
+# (0.0001 % of pitch); the outline is sampled at 0.005 mm with the tip corner an exact vertex, and
+# the last flank chord's normal differs from the corner's by step/(2·re), which moves the limit by
+# r·step/(2·re)/R ≈ 9e-7 (0.00009 %). So the limit is known to about 0.0002 %: the bracket plus
+# the chord error.
+WEAR_LIMIT_PCT = 1.6564
+WEAR_LIMIT_TOL_PCT = 2e-4
+
+
+@pytest.fixture(scope="module")
+def template(templates_dir):
+    return templates_dir / f"{TEMPLATE}.toml"
+
+
+@pytest.fixture(scope="module")
+def lay(template):
+    return layout.track_layout(load_template(template).params)
+
+
+@pytest.fixture(scope="module")
+def limit(lay):
+    return wear.wear_limit(lay.sprocket.gap, lay.link, lay.wrap, 0.015)
+
+
+def closed_form_limit(gap, sleeve_radius_mm: float) -> float:
+    """Independent closed form: at the limit the sleeve touches the flank exactly at the tip
+    corner C, so its centre is C + r·n (n the flank's outward normal at C, from the flank centre
+    through C), and its distance from the axis is R·(1 + e)."""
+    c, f = gap.tip_corner, gap.flank_centre
+    n = (c - f) / np.linalg.norm(c - f)
+    return float(np.linalg.norm(c + sleeve_radius_mm * n)) / gap.pitch_radius_mm - 1.0
+
+
+# --- the exact 2-D model (no CAD) ----------------------------------------------------------------
+
+
+def test_template_wear_limit_figure_and_closed_form(lay, limit):
+    """1.6564 % on the template, set by the sleeve riding up the flank to the tip corner; the
+    bisection bracket holds the closed form."""
+    assert limit.mode == "tip"
+    assert 100 * limit.limit == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
+    assert 0 < limit.fail_at - limit.limit <= wear.WEAR_BISECTION_TOL
+    gap, r = lay.sprocket.gap, lay.link.sleeve_radius_mm
+    exact = closed_form_limit(gap, r)
+    # the polyline's last flank chord (0.005 mm) turns its normal by step/(2·re) from the corner's,
+    # moving the sleeve centre by r·step/(2·re): ≈ 9e-7 in e at R = 117.3 mm
+    chord = r * wear.SEAT_OUTLINE_STEP_MM / (2.0 * gap.flank_radius_mm) / gap.pitch_radius_mm
+    assert limit.limit - chord <= exact <= limit.fail_at + chord
+    assert exact == pytest.approx(wear.tip_limit_closed_form(lay.sprocket.gap, lay.link.sleeve_radius_mm), abs=1e-12)
+    # the short tooth (tip 0.2 mm above the pitch circle) tolerates less than ANSI's 3 % ceiling
+    assert limit.limit < 0.03 and limit.ok
+
+
+def test_seat_check_modes_and_sweep(lay, limit):
+    """Unworn and at the declared 1.5 % every link seats and the worn-pitch sweep is clear; just
+    past the limit the flank contact is at the tip corner; far past it the sleeve clears the tooth."""
+    gap, r = lay.sprocket.gap, lay.link.sleeve_radius_mm
+    new = wear.seat_check(gap, r, 0.0)
+    assert new.ok and new.contact_radius_mm < gap.tip_radius_mm
+    assert limit.declared_seat.ok and limit.declared_sweep.ok
+    assert limit.declared_sweep.min_plate_mm > 0.75  # the worn chain rides higher: the plate lifts away
+    past = wear.seat_check(gap, r, limit.fail_at)
+    assert not past.ok and past.mode == "tip"
+    assert past.contact_radius_mm == pytest.approx(gap.tip_radius_mm, abs=1e-4)
+    # sleeve bottom above the tip circle: no contact at all before the tooth's centre line
+    lifted = (gap.tip_radius_mm + r) / gap.pitch_radius_mm - 1.0 + 1e-3
+    assert wear.seat_check(gap, r, lifted).mode == "jump"
+    assert wear.sweep_check(gap, lay.link, lay.wrap, 0.0).min_sleeve_mm == pytest.approx(
+        gap.seating_radius_mm - r, abs=1e-4)
+
+
+def test_wear_field_range_and_default(template):
+    assert load_template(template).params.chain.wear_elongation_pct == 1.5
+    with pytest.raises(ParamError):
+        load_template(template, ["chain.wear_elongation_pct=-1"])
+    with pytest.raises(ParamError):
+        load_template(template, ["chain.wear_elongation_pct=30"])
+
+
+# --- the check (sweep, cad) ------------------------------------------------------------------------
+
+
+@pytest.mark.cad
+def test_template_passes_with_the_wear_verdict_and_figures(build_bodies):
+    run = build_bodies(TEMPLATE)
+    result = pipeline.sweep(run.design, run.assembly, run.bodies, jobs=1, options={"steps_per_cycle": 12})
+    verdicts = {v.name: v for v in result.verdicts}
+    assert result.passed, [v for v in result.verdicts if not v.passed]
+    assert verdicts["chain_wear_within_limit"].passed
+    s = result.summary
+    assert s["wear_declared_pct"] == 1.5
+    assert s["wear_limit_pct"] == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
+    assert wear.MODES[s["wear_limit_mode"]] == "tip" and s["wear"]["limit_mode_tip"] == 1
+    assert s["wear"]["declared_seats"] == 1 and s["wear"]["declared_sweep_clear"] == 1
+    # the mesh sweep of the worn chain (same link meshes at pitch p·1.015) confirms the exact sweep
+    w = s["wear"]
+    assert w["mesh_confirms_declared_sweep"] == 1 and w["mesh_declared_collisions"] == 0
+    assert w["mesh_declared_max_deviation_mm"] <= s["mesh_error_bound_mm"]
+    assert w["mesh_declared_min_sleeve_mm"] > s["min_tooth_sleeve_clearance_mm"]  # the worn chain rides higher
+    assert w["mesh_declared_min_plate_mm"] > s["min_tip_plate_distance_mm"]
+
+
+@pytest.mark.cad
+def test_declared_wear_above_the_limit_fails_with_exit_1(template, tmp_path):
+    out = tmp_path / "worn"
+    proc = subprocess.run([sys.executable, "-m", "gearcheck", "check", str(template), "--set",
+                           "chain.wear_elongation_pct=2", "--out", str(out), "--jobs", "1"],
+                          check=False, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 1, proc.stderr
+    s = json.loads((out / "summary.json").read_text())["track"]
+    assert s["verdicts"]["chain_wear_within_limit"] == 0
+    assert all(v == 1 for k, v in s["verdicts"].items() if k != "chain_wear_within_limit")
+    assert s["wear_declared_pct"] == 2.0
+    assert s["wear_limit_pct"] == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
+    assert s["wear"]["declared_seats"] == 0
+    line = next(ln for ln in proc.stdout.splitlines() if "declared chain wear" in ln)
+    assert "fail" in line.lower() and "declared 2.000 %, limit 1.656" in line
+
+
+# --- labels --------------------------------------------------------------------------------------
+
+
+def _calc(template, *overrides):
+    return {f.key: f for f in calc(load_template(template, list(overrides)).params)}
+
+
+def test_paper_values_beside_the_paper_design_only(template):
+    paper = _calc(template)
+    assert paper["pitch_diameter_mm"].paper == 234.6 and paper["max_drive_force_N"].paper == 234.0
+    assert paper["teeth_for_initial_pitch_diameter"].note == "rounded up to the odd z = 49"
+    assert "within 1 % of 234 N" in paper["max_drive_force_N"].note
+
+    other = _calc(template, "sprocket.teeth=51", "chain.pitch_mm=25")
+    assert all(f.paper is None for k, f in other.items() if k != "max_drive_force_N")
+    z = other["teeth_for_initial_pitch_diameter"]
+    assert z.value == pytest.approx(57.69, abs=0.005)
+    assert "rounded" not in z.note and "51" in z.note and "59" in z.note
+    # the loads are the paper's: its 234 N stays beside the drive force (also at g = 9.81)
+    assert other["max_drive_force_N"].paper == 234.0
+    assert _calc(template, "robot.g_m_s2=9.81")["max_drive_force_N"].paper == 234.0
+    heavier = _calc(template, "robot.mass_kg=200")["max_drive_force_N"]
+    assert heavier.paper is None and "234" not in heavier.note
+
+
+def test_paper_values_in_calc_json_only_for_the_paper_design(template, capsys):
+    assert main(["calc", str(template), "--json", "--set", "sprocket.teeth=51", "--set", "chain.pitch_mm=25",
+                 "--set", "robot.mass_kg=200"]) == 0
+    data = json.loads(capsys.readouterr().out)["track"]
+    assert "paper" not in data
+
+
+def test_calc_shows_the_declared_wear_and_the_closed_form_limit(template):
+    f = _calc(template)
+    assert f["wear_elongation_pct"].value == 1.5
+    assert f["wear_limit_tip_pct"].value == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
+    assert f["wear_limit_tip_pct"].note.startswith("pass")
+    assert _calc(template, "chain.wear_elongation_pct=2")["wear_limit_tip_pct"].note.startswith("FAIL")
+
+
+def test_sprocket_speed_from_the_chain_advance_per_turn(template):
+    """Every other tooth engages: z/2 links of p pass per turn (735 mm at z = 49), not π·d
+    (737.0 mm): 122.45 rpm at 1.5 m/s instead of 122.12 (π·d read 0.27 % slow)."""
+    f = _calc(template)
+    d = f["pitch_diameter_mm"].value
+    rpm = f["sprocket_speed_rpm"].value
+    assert rpm == pytest.approx(1.5 * 60_000 / (49 * 30 / 2), rel=1e-12)
+    assert rpm == pytest.approx(122.449, abs=1e-3)
+    assert 1.5 * 60_000 / (math.pi * d) / rpm - 1 == pytest.approx(-0.00274, abs=1e-4)
+
+
+def test_assembly_carries_the_declared_wear(template):
+    """The assembly carries the declared wear to the sweep (fraction); the worn wrap puts the seated
+    pins on R·(1 + e), p·(1 + e) apart."""
+    model = get("track").assembly(load_template(template, ["chain.wear_elongation_pct=2"]).params).layout
+    assert model.wear_elongation == pytest.approx(0.02)
+    w = wear.worn_wrap(model.wrap.teeth, model.wrap.pitch_mm, 0.02, model.wrap)
+    pins = w.pin_positions(0.0)
+    seated = np.flatnonzero(w.seated_pins(0.0))
+    assert np.hypot(*pins[seated].T) == pytest.approx(model.gap.pitch_radius_mm * 1.02, rel=1e-12)
+    assert np.hypot(*(pins[1:] - pins[:-1]).T) == pytest.approx(30.0 * 1.02, rel=1e-12)
