@@ -48,7 +48,8 @@ def test_bad_input_is_one_line(spur):
 def test_pipeline_checks_it_end_to_end(checked):
     design, run = checked
     assert run.passed, [(v.name, v.measured) for v in run.verdicts]
-    assert [v.name for v in run.verdicts] == ["no_interference", "backlash_positive", "mesh_agrees_with_exact"]
+    assert [v.name for v in run.verdicts] == ["no_interference", "backlash_positive", "mesh_agrees_with_exact",
+                                              "exact_confirmation"]
     s = run.summary["spur_pair"]
     # the mesh play is the exact j / r2 within the meshes' bound and the polygon's sag
     assert s["max_mesh_exact_deviation_arcmin"] <= s["allowed_deviation_arcmin"]

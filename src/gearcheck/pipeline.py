@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Protocol
 
 from gearcheck.design import TOL_MAX_MM, TOL_MIN_MM
 from gearcheck.params import ParamError
-from gearcheck.results import CheckResult, Confirmation
+from gearcheck.results import CheckResult, Confirmation, Verdict
 
 if TYPE_CHECKING:
     from gearcheck.cad.export import ExportedPart
@@ -263,8 +263,8 @@ def apply_resolution_rule(design: Design, result: CheckResult, bodies: Mapping[s
 def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
             progress: ProgressFactory = no_progress) -> list[Confirmation]:
     """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
-    from gearcheck.cad.confirm import exact_distance
-    from gearcheck.sweep.tools import mesh_nearest_midpoint
+    from gearcheck.cad.confirm import exact_distance, exact_overlap
+    from gearcheck.sweep.tools import mesh_nearest_midpoint, meshes_overlap
 
     by_name = {p.name: p for p in parts}
     log.info("stage confirm: %d worst poses on the exact B-rep", len(result.worst_poses))
@@ -272,11 +272,33 @@ def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
     with progress("exact B-rep distance at worst poses", len(result.worst_poses), "pose") as bar:
         for worst in result.worst_poses:
             bound = sum(bodies[n.partition(".")[0]].error_bound_mm for n in (worst.part_a, worst.part_b))
-            brep = exact_distance(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
+            overlap = None
+            if worst.mesh_distance_mm <= 0.0 or meshes_overlap(bodies, worst):
+                # the meshes' nearest points mean nothing here: measure the whole solids
+                brep, overlap = exact_overlap(by_name, worst)
+            else:
+                brep = exact_distance(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
             out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
-                                    worst.mesh_distance_mm, brep, bound))
+                                    worst.mesh_distance_mm, brep, bound, overlap))
             bar.update(1)
     return out
+
+
+def confirmation_verdict(confirmations: list[Confirmation]) -> Verdict:
+    """The exact B-rep confirmation as a verdict: at every worst pose the mesh and the exact
+    solids agree within the pair's mesh-error bound (distances at free poses; contact or overlap
+    where the meshes overlap)."""
+    bad = [c for c in confirmations if not c.agrees]
+    parts = []
+    for c in confirmations:
+        if c.meshes_overlap:
+            volume = "not computed" if c.overlap_mm3 != c.overlap_mm3 else f"{c.overlap_mm3:.4g} mm³"  # NaN
+            parts.append(f"{c.parts}: meshes overlap, exact distance {c.brep_mm:.2e} mm, common volume {volume}")
+        else:
+            parts.append(f"{c.parts}: mesh {c.mesh_mm:.5f} vs B-rep {c.brep_mm:.5f} mm (bound {c.bound_mm:.4f})")
+    return Verdict.of("exact_confirmation", "worst poses confirmed on the exact B-rep", not bad,
+                      "; ".join(parts) if parts else "no worst pose to confirm",
+                      {"poses": float(len(confirmations)), "disagreeing": float(len(bad))})
 
 
 # ------------------------------------------------------------------------------------------
@@ -344,6 +366,7 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
                        progress=progress)
         apply_resolution_rule(design, result, run.bodies, run.tol_mm)
         result.confirmations = confirm(result, run.parts, run.bodies, progress)
+        result.verdicts.append(confirmation_verdict(result.confirmations))
         _, summary = write_report(design, txn.staging, result, run.manifest)
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()

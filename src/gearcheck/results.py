@@ -124,9 +124,28 @@ class Confirmation:
     mesh_mm: float
     brep_mm: float
     bound_mm: float
+    # where the meshes overlap at the pose: the exact solids' common volume (mm³); None when free
+    overlap_mm3: float | None = None
+
+    @property
+    def meshes_overlap(self) -> bool:
+        return self.overlap_mm3 is not None
+
+    @property
+    def agrees(self) -> bool:
+        """Mesh and B-rep tell the same story within the pair's mesh-error bound: at a free pose
+        the two distances agree; where the meshes overlap, the exact solids are in contact or
+        overlap too (their distance is within the bound)."""
+        if self.meshes_overlap:
+            return self.brep_mm <= self.bound_mm
+        return abs(self.mesh_mm - self.brep_mm) <= self.bound_mm
 
     def figures(self) -> dict[str, float]:
-        return {"mesh_mm": self.mesh_mm, "brep_mm": self.brep_mm, "bound_mm": self.bound_mm}
+        out = {"mesh_mm": self.mesh_mm, "brep_mm": self.brep_mm, "bound_mm": self.bound_mm,
+               "agrees": float(self.agrees)}
+        if self.overlap_mm3 is not None:
+            out["overlap_mm3"] = self.overlap_mm3
+        return out
 
 
 @dataclass

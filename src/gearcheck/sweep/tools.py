@@ -170,6 +170,15 @@ def extrapolated_event(grid: np.ndarray, flags_at: Callable[[float], np.ndarray]
     return 2.0 * brackets[0].value - brackets[1].value, brackets[0]
 
 
+def meshes_overlap(bodies, worst) -> bool:
+    """Whether the two meshes intersect at a worst pose (FCL collide on the whole parts)."""
+    names = [n.partition(".")[0] for n in (worst.part_a, worst.part_b)]
+    scene = Scene([bodies[names[0]].scaled(worst.scale_a).mesh, bodies[names[1]].scaled(worst.scale_b).mesh])
+    scene.set_pose(names[0], np.asarray(worst.pose_a, float))
+    scene.set_pose(names[1], np.asarray(worst.pose_b, float))
+    return scene.collide(names[0], names[1])
+
+
 def mesh_nearest_midpoint(bodies, worst) -> np.ndarray | None:
     """Where the meshes come closest at a worst pose (world frame): the exact distance is then
     measured on the faces around it only. None for a feature of a part ("link_03.plate"): the
