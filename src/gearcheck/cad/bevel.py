@@ -24,7 +24,6 @@ from dataclasses import dataclass
 
 import cadquery as cq
 from OCP.BRepAdaptor import BRepAdaptor_Surface
-from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 from OCP.BRepBuilderAPI import (BRepBuilderAPI_MakeSolid, BRepBuilderAPI_MakeWire,
                                 BRepBuilderAPI_Sewing, BRepBuilderAPI_Transform)
 from OCP.BRepCheck import BRepCheck_Analyzer
@@ -37,8 +36,8 @@ from OCP.ShapeUpgrade import ShapeUpgrade_UnifySameDomain
 from OCP.TopAbs import TopAbs_SHELL
 from OCP.TopExp import TopExp_Explorer
 from OCP.TopoDS import TopoDS
-from OCP.TopTools import TopTools_ListOfShape
 
+from gearcheck.cad.primitives import boolean_common
 from gearcheck.geometry.bevel import BevelGearSpec, SectionProfile, section_profile
 
 # Interpolation points per flank (uniform in roll angle). Measured with flank_distance on the
@@ -109,16 +108,10 @@ def blank_solid(spec: BevelGearSpec, seam_azimuth_deg: float = 180.0) -> cq.Soli
 
 
 def _common(a: cq.Shape, b: cq.Shape) -> cq.Shape:
-    op = BRepAlgoAPI_Common()
-    args, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
-    args.Append(a.wrapped)
-    tools.Append(b.wrapped)
-    op.SetArguments(args)
-    op.SetTools(tools)
-    op.Build()
-    if not op.IsDone():
+    shape = boolean_common(a.wrapped, b.wrapped)
+    if shape is None:
         raise RuntimeError("bevel blank boolean failed")
-    return cq.Shape.cast(op.Shape())
+    return cq.Shape.cast(shape)
 
 
 def sector_loft(spec: BevelGearSpec, flank_points: int = FLANK_SPLINE_POINTS) -> cq.Solid:

@@ -14,16 +14,15 @@ import math
 import numpy as np
 from OCP.Bnd import Bnd_Box
 from OCP.BRep import BRep_Builder
-from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
 from OCP.BRepBndLib import BRepBndLib
 from OCP.BRepGProp import BRepGProp
 from OCP.GProp import GProp_GProps
 from OCP.BRepExtrema import BRepExtrema_DistShapeShape
 from OCP.gp import gp_Pnt
 from OCP.TopoDS import TopoDS_Compound
-from OCP.TopTools import TopTools_ListOfShape
 
 from gearcheck.cad.placement import Part, place
+from gearcheck.cad.primitives import boolean_common
 from gearcheck.results import WorstPose
 
 
@@ -83,19 +82,11 @@ def exact_overlap(parts: dict[str, Part], worst: WorstPose) -> tuple[float, floa
         raise RuntimeError(f"BRepExtrema failed at {worst.label}")
     # a fuzzy Boolean (tolerance far below any mesh bound): the plain one returned a negative
     # volume on the differential's cold gears, whose flanks cross at grazing angles
-    common = BRepAlgoAPI_Common()
-    args, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
-    args.Append(a.wrapped)
-    tools.Append(b.wrapped)
-    common.SetArguments(args)
-    common.SetTools(tools)
-    common.SetFuzzyValue(COMMON_FUZZY_MM)
-    common.SetNonDestructive(True)
-    common.Build()
+    common = boolean_common(a.wrapped, b.wrapped, fuzzy_mm=COMMON_FUZZY_MM)
     volume = math.nan  # unknown unless the Boolean gives a sane volume
-    if common.IsDone():
+    if common is not None:
         props = GProp_GProps()
-        BRepGProp.VolumeProperties_s(common.Shape(), props)
+        BRepGProp.VolumeProperties_s(common, props)
         if props.Mass() >= 0.0:
             volume = float(props.Mass())
     return float(dist.Value()), volume

@@ -1,10 +1,30 @@
-"""Solids of the simple specs in :mod:`gearcheck.geometry.solids` (rings, fused ring stacks)."""
+"""Solids of the simple specs in :mod:`gearcheck.geometry.solids` (rings, fused ring stacks),
+and the one Boolean intersection the CAD layer uses."""
 
 from __future__ import annotations
 
 import cadquery as cq
+from OCP.BRepAlgoAPI import BRepAlgoAPI_Common
+from OCP.TopoDS import TopoDS_Shape
+from OCP.TopTools import TopTools_ListOfShape
 
 from gearcheck.geometry.solids import Ring, RingStack
+
+
+def boolean_common(a: TopoDS_Shape, b: TopoDS_Shape, fuzzy_mm: float | None = None) -> TopoDS_Shape | None:
+    """The common part of two shapes (OCCT's general-fuse Common); ``fuzzy_mm`` makes it treat
+    surfaces that close as touching and leaves the arguments untouched. None when OCCT fails."""
+    op = BRepAlgoAPI_Common()
+    args, tools = TopTools_ListOfShape(), TopTools_ListOfShape()
+    args.Append(a)
+    tools.Append(b)
+    op.SetArguments(args)
+    op.SetTools(tools)
+    if fuzzy_mm is not None:
+        op.SetFuzzyValue(fuzzy_mm)
+        op.SetNonDestructive(True)
+    op.Build()
+    return op.Shape() if op.IsDone() else None
 
 
 def build_ring(ring: Ring) -> cq.Shape:
