@@ -62,20 +62,19 @@ def sweep_sample(design: Design) -> dict:
     ParamError: rejected after meshing."""
     import tempfile
 
-    from gearcheck import resolution
 
     impl = design.impl
     with tempfile.TemporaryDirectory() as tmp:
         run = pipeline.build(design, Path(tmp))
-    result = pipeline.sweep(design, run.assembly, run.bodies, options=impl.fuzz_options(design.params))
-    pipeline.apply_resolution_rule(design, result, run.bodies, run.tol_mm)
+    result = pipeline.sweep(design, run.assembly, run.bodies, options=impl.fuzz_options(design.params),
+                            mesh_plan=run.mesh_plan)
     verdicts = {v.name: int(v.passed) for v in result.verdicts}
     broken = [k for k in impl.consistency_verdicts if verdicts.get(k) == 0]
     if broken:
         details = "; ".join(v.measured for v in result.verdicts if v.name in broken)
         raise AssertionError(f"mesh sweep disagrees with the exact model: {details}")
     return {"verdicts": verdicts, "verdict_pass": int(result.passed),
-            "mesh_resolution": resolution.resolution_summary(result, run.bodies)}
+            "mesh_resolution": result.summary["mesh_resolution"]}
 
 
 def _reason(exc: ParamError) -> str:

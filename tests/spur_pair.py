@@ -160,6 +160,11 @@ class SpurPair(Mechanism):
                                   (2, g.teeth_2, params.backlash.thinning_2_mm))}
         return Assembly(self.name, parts, solids, layout=s)
 
+    def smallest_clearance(self, params: Any) -> Clearance | None:
+        """Before meshing: the normal backlash splits into a gap on each side of the meshing
+        teeth when gear 2 sits centred: j·cos α / 2, the clearance the sweep decides."""
+        return Clearance(self._sizes(params)["normal_mm"] / 2, "normal backlash per side (exact: j·cos α / 2)")
+
     def parts(self, assembly: Assembly) -> list:
         from gearcheck.cad.placement import Part
         from gearcheck.cad.profile import extruded_outline
@@ -211,14 +216,21 @@ class SpurPair(Mechanism):
         s = outcome.summary
         return [
             Verdict.of("no_interference", "no interference at the centred poses", bool(s["centred_poses_free"]),
-                       f"{s['phases']} phases over one pitch free" if s["centred_poses_free"] else "a centred pose collides"),
-            Verdict.of("backlash_positive", "gear 2 turns freely both ways", s["geom_play_min_arcmin"] > 0,
-                       f"least play {s['geom_play_min_arcmin']:.3f}′", {"least_play_arcmin": s["geom_play_min_arcmin"]}),
+                       f"{s['phases']} phases over one pitch free" if s["centred_poses_free"] else "a centred pose collides",
+                       evidence="mesh sweep (FCL collide at every phase)"),
+            # a mesh that cannot resolve the backlash cannot tell its sign: the exact j / r2 decides
+            Verdict.of("backlash_positive", "gear 2 turns freely both ways",
+                       (s["geom_play_min_arcmin"] if outcome.mesh_resolves else s["exact_play_arcmin"]) > 0,
+                       f"least play {s['geom_play_min_arcmin']:.3f}′ (exact {s['exact_play_arcmin']:.3f}′)",
+                       {"least_play_arcmin": s["geom_play_min_arcmin"]},
+                       evidence="mesh sweep (bisection to contact both ways)" if outcome.mesh_resolves
+                       else "exact model (j / r2): the meshes cannot resolve the backlash"),
             Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with j / r2",
                        s["max_mesh_exact_deviation_arcmin"] <= s["allowed_deviation_arcmin"],
                        f"largest difference {s['max_mesh_exact_deviation_arcmin']:.4f}′, allowed "
                        f"{s['allowed_deviation_arcmin']:.4f}′",
-                       {"deviation_arcmin": s["max_mesh_exact_deviation_arcmin"]}),
+                       {"deviation_arcmin": s["max_mesh_exact_deviation_arcmin"]},
+                       evidence="mesh sweep against the exact model"),
         ]
 
     def report(self, params: Any, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:

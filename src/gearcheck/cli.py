@@ -70,9 +70,10 @@ Examples:
   gearcheck check templates/eod_track_drive.toml --jobs 2
 """
 
-TOL_HELP = ("absolute chordal tolerance of the meshes in mm (default per mechanism: {defaults} — fine enough "
-            "that the mesh-error bound is at most 1/10 of the smallest clearance the check decides on; "
-            "`check` refuses coarser meshes)")
+TOL_HELP = ("absolute chordal tolerance of the meshes in mm, used as given (default per mechanism: {defaults}, "
+            "refined before meshing so that the two meshes' error bounds together stay within 1/10 of the "
+            "smallest clearance the design asks to decide, from its exact model; where a mesh cannot resolve "
+            "it, the exact model and the exact B-rep decide, and the report says so)")
 
 
 class _Parser(argparse.ArgumentParser):
@@ -175,7 +176,9 @@ def build_parser() -> argparse.ArgumentParser:
         "for the track drive, towing and power modes for the steering), confirm each sweep's "
         "worst pose on the exact B-rep, and write DIR/report.html (verdicts, paper vs model vs "
         "geometry, plots), DIR/summary.json (numbers) and DIR/sweep.csv (one row per pose) beside "
-        "the CAD. Exit 0 when every verdict passes, 1 when one fails, 2 on bad input.",
+        "the CAD. Each verdict is pass, warn or fail and names the evidence that decided it (exact "
+        "model, mesh sweep, exact B-rep). Exit 0 when no verdict fails (warnings included), 1 when "
+        "one fails, 2 on input no design can meet.",
     )
     _add_cad_args(check, "check")
 
@@ -212,12 +215,12 @@ def _bars(desc: str, total: int | None = None, unit: str = "") -> Iterator[Bar]:
 
 
 def _print_verdicts(design: Design, folder: Path, result) -> None:
-    verdict = "PASS" if result.passed else "FAIL"
-    print(f"{verdict} {design.name}: {sum(v.passed for v in result.verdicts)}/{len(result.verdicts)} verdicts; "
-          f"report {folder / 'report.html'}")
+    warned = sum(v.level == "warn" for v in result.verdicts)
+    print(f"{result.level.upper()} {design.name}: {sum(v.passed for v in result.verdicts)}/{len(result.verdicts)} "
+          f"verdicts pass{f', {warned} with a warning' if warned else ''}; report {folder / 'report.html'}")
     for v in result.verdicts:
         word = {"pass": "pass", "warn": "warn", "fail": "FAIL"}[v.level]
-        print(f"  [{word}] {v.label}: {v.measured}")
+        print(f"  [{word}] {v.label}: {v.measured}" + (f" [{v.evidence}]" if v.evidence else ""))
 
 
 # ------------------------------------------------------------------------------------------

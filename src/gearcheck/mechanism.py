@@ -34,7 +34,7 @@ if TYPE_CHECKING:  # type names only: importing a mechanism costs neither CadQue
 
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
-    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body, MeshData
     from gearcheck.sweep.motion import Motion
 
@@ -142,6 +142,14 @@ class Mechanism(ABC):
     @abstractmethod
     def assembly(self, params: Any) -> Assembly:
         """The parts as data: specs, poses as built, motions (numpy only)."""
+
+    def smallest_clearance(self, params: Any) -> Clearance | None:
+        """Before meshing: the smallest non-zero clearance (mm, its magnitude; a negative
+        clearance — an overlap — counts by its depth) between two meshed parts that the sweep
+        will decide a verdict on, from the exact model (numpy only). The mesh tolerance follows
+        from it (the pair's mesh-error bound ≤ 1/10 of it, :mod:`gearcheck.resolution`). None:
+        nothing to resolve (zero-backlash contact decided within a contact tolerance)."""
+        return None
 
     # -- the CAD hook -------------------------------------------------------------------------
     @abstractmethod

@@ -1,5 +1,6 @@
-"""The one pipeline: build → mesh → sweep (through an executor) → mesh-resolution rule → exact
-B-rep confirmation → files. The CLI, the Python API, the benchmarks and the tests all call it.
+"""The one pipeline: smallest clearance → mesh tolerance → build → mesh → sweep (through an
+executor) → mesh-resolution rule → verdicts → exact B-rep confirmation → files. The CLI, the
+Python API, the benchmarks and the tests all call it.
 
 Each stage is a function of the previous stage's output, so a caller can stop anywhere:
 :func:`build_parts` (solids, no files), :func:`build` (solids, meshes, STEP/STL/manifest),
@@ -25,6 +26,7 @@ from gearcheck.results import CheckResult, Confirmation, Verdict
 
 if TYPE_CHECKING:
     from gearcheck.cad.export import ExportedPart
+    from gearcheck.resolution import MeshPlan
     from gearcheck.cad.placement import Part
     from gearcheck.design import Design
     from gearcheck.executor import Executor
@@ -59,13 +61,22 @@ def check_tol(tol_mm: float | None) -> None:
         raise ParamError("--tol", tol_mm, f"out of range: allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm")
 
 
-def mesh_tol(design: Design, tol_mm: float | None) -> float:
-    """--tol, else the template's ``mesh_tol_mm`` (a params.toml records the tolerance its run
-    used), else the mechanism's default (fine enough for the template's smallest clearance)."""
-    if tol_mm is not None:
-        return tol_mm
-    recorded = design.data.get("mesh_tol_mm")
-    return float(recorded) if recorded is not None else design.impl.mesh_tol_mm
+def mesh_plan(design: Design, tol_mm: float | None) -> MeshPlan:
+    """The chordal tolerance to mesh at (:mod:`gearcheck.resolution`). ``--tol`` or a
+    ``mesh_tol_mm`` key (a params.toml records the tolerance its run used) is used as given;
+    otherwise the mechanism's default, refined so the meshes resolve the smallest clearance the
+    design asks to decide (from its exact model, before meshing)."""
+    from gearcheck import resolution
+
+    given = tol_mm if tol_mm is not None else design.data.get("mesh_tol_mm")
+    requested = float(given) if given is not None else float(design.impl.mesh_tol_mm)
+    check_tol(requested)
+    t0 = time.perf_counter()
+    clearance = design.impl.smallest_clearance(design.params)
+    log.info("stage plan: smallest clearance to decide: %s (%.2f s)",
+             "none" if clearance is None else f"{clearance.value_mm:.5g} mm, {clearance.label}",
+             time.perf_counter() - t0)
+    return resolution.plan_tolerance(requested, given is not None, clearance)
 
 
 def run_params(design: Design, tol_mm: float) -> dict:
@@ -98,6 +109,7 @@ class BuildRun:
     design: Design
     folder: Path
     tol_mm: float
+    mesh_plan: MeshPlan
     assembly: Assembly
     parts: list[Part]
     exported: list[ExportedPart]
@@ -137,17 +149,18 @@ def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: Pr
     folder: the caller commits it)."""
     from gearcheck.cad.export import export_parts
 
-    tol = mesh_tol(design, tol_mm)
-    check_tol(tol)
+    plan = mesh_plan(design, tol_mm)
+    tol = plan.tol_mm
     log.info("stage build: %s (%s), solids", design.name, design.mechanism)
     assembly, parts = build_parts(design)
     log.info("stage mesh: %s, %d parts at %g mm", design.name, len(parts), tol)
     with progress(f"meshing {design.name}", len(parts), "part") as bar:
         manifest, exported = export_parts(parts, folder, name=design.name, mechanism=design.mechanism,
                                           params_data=run_params(design, tol), tol_mm=tol,
+                                          extra={"mesh_tolerance": plan.manifest()},
                                           progress=lambda _name: bar.update(1),
                                           params_comment=provenance(design, overrides))
-    return BuildRun(design, folder, tol, assembly, parts, exported, sweep_bodies(exported), manifest)
+    return BuildRun(design, folder, tol, plan, assembly, parts, exported, sweep_bodies(exported), manifest)
 
 
 def _seal(folder: Path, manifest: dict, extra: Mapping[str, str] | None, shown: Path) -> dict:
@@ -166,6 +179,12 @@ def _seal(folder: Path, manifest: dict, extra: Mapping[str, str] | None, shown: 
         return verify_run(folder)
     except RunIncomplete as exc:
         raise OutputError(shown / exc.file if exc.file else shown, f"cannot write: {exc}") from None
+
+
+def seal(folder: Path, manifest: dict, shown: Path) -> dict:
+    """List every file of a staged run in its manifest and verify the folder against it (see
+    :func:`_seal`): for runs other than a build or a check (a study)."""
+    return _seal(folder, manifest, None, shown)
 
 
 def write_files(design: Design, folder: Path, files: Mapping[str, str]) -> Path:
@@ -208,15 +227,21 @@ def build(design: Design, folder: Path, *, tol_mm: float | None = None,
 
 def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, executor: Executor | None = None,
           jobs: int | None = None, options: Mapping[str, Any] | None = None,
-          progress: ProgressFactory = no_progress) -> CheckResult:
+          progress: ProgressFactory = no_progress, mesh_plan: MeshPlan | None = None) -> CheckResult:
     """Plan the mechanism's sweep on the meshed bodies, run its tasks on ``executor`` (default:
-    a local pool of ``jobs`` processes, every core), reduce, and give verdicts and report
-    content. No files; the mesh-resolution rule and the exact confirmation come after."""
+    a local pool of ``jobs`` processes, every core), reduce, check the mesh-resolution rule
+    (``mesh_plan``: how the bodies were meshed; default: as they are, for the design's smallest
+    clearance), and give verdicts and report content. No files; the exact B-rep confirmation
+    comes after."""
+    from gearcheck import resolution
     from gearcheck.executor import make_executor
     from gearcheck.sweep.plan import make_scene, run_task
 
     impl = design.impl
     check_poses(assembly, bodies)
+    if mesh_plan is None:
+        tol = max(float(b.error_bound_mm) for b in bodies.values())
+        mesh_plan = resolution.MeshPlan(tol, tol, True, impl.smallest_clearance(design.params))
     executor = executor if executor is not None else make_executor(jobs)
     plan = impl.plan(design.params, assembly, bodies, options)
     log.info("stage sweep: %s, %d tasks on %d worker(s)", design.name, len(plan.tasks), executor.jobs)
@@ -227,12 +252,17 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs,
              time.perf_counter() - t0)
     outcome = plan.reduce(results)
+    rule = resolution.assess(mesh_plan, bodies)
+    outcome.mesh_resolves = rule.resolves
     verdicts = impl.verdicts(design.params, outcome)
     report = impl.report(design.params, outcome, verdicts)
     timings = dict(outcome.timings)
     timings.setdefault("workers", executor.jobs)
-    return CheckResult(impl.section, outcome.summary, verdicts, report.rows, report.comparisons, report.plots,
-                       report.notes, outcome.worst_poses, timings, outcome.smallest_clearance)
+    summary = dict(outcome.summary)
+    summary["mesh_resolution"] = rule.summary()
+    return CheckResult(impl.section, summary, verdicts, report.rows, report.comparisons, report.plots,
+                       [*report.notes, rule.describe()], outcome.worst_poses, timings, mesh_plan.clearance,
+                       resolution=rule)
 
 
 def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
@@ -245,19 +275,6 @@ def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
             raise ValueError(f"missing body {spec.name!r}: expected the parts {assembly.names}")
         if not np.allclose(bodies[spec.name].pose, spec.pose, atol=1e-9):
             raise ValueError(f"{spec.name}: pose differs from the assembly's (built with other parameters?)")
-
-
-def apply_resolution_rule(design: Design, result: CheckResult, bodies: Mapping[str, Body],
-                          tol_mm: float) -> None:
-    """After meshing and sweeping: meshes too coarse for the smallest clearance checked are bad
-    input (``--tol``, one line); otherwise the rule's figures join the summary and the notes."""
-    from gearcheck import resolution
-
-    why = resolution.violation(result, dict(bodies))
-    if why is not None:
-        raise ParamError("--tol", tol_mm, why, design.source)
-    result.summary["mesh_resolution"] = resolution.resolution_summary(result, dict(bodies))
-    result.notes.append(resolution.describe(result, dict(bodies)))
 
 
 def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
@@ -284,10 +301,12 @@ def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
     return out
 
 
-def confirmation_verdict(confirmations: list[Confirmation]) -> Verdict:
+def confirmation_verdict(confirmations: list[Confirmation], rule: Any = None) -> Verdict:
     """The exact B-rep confirmation as a verdict: at every worst pose the mesh and the exact
     solids agree within the pair's mesh-error bound (distances at free poses; contact or overlap
-    where the meshes overlap)."""
+    where the meshes overlap). Where the meshes cannot resolve the design's smallest clearance
+    (``rule``: :class:`gearcheck.resolution.Resolution`), the B-rep figures are the evidence at
+    those poses, and the verdict says so."""
     bad = [c for c in confirmations if not c.agrees]
     parts = []
     for c in confirmations:
@@ -296,9 +315,12 @@ def confirmation_verdict(confirmations: list[Confirmation]) -> Verdict:
             parts.append(f"{c.parts}: meshes overlap, exact distance {c.brep_mm:.2e} mm, common volume {volume}")
         else:
             parts.append(f"{c.parts}: mesh {c.mesh_mm:.5f} vs B-rep {c.brep_mm:.5f} mm (bound {c.bound_mm:.4f})")
+    unresolved = rule is not None and not rule.resolves
+    evidence = ("exact B-rep: the meshes cannot resolve the smallest clearance, so the B-rep distances at the "
+                "worst poses are the evidence there" if unresolved else "exact B-rep against the mesh sweep")
     return Verdict.of("exact_confirmation", "worst poses confirmed on the exact B-rep", not bad,
                       "; ".join(parts) if parts else "no worst pose to confirm",
-                      {"poses": float(len(confirmations)), "disagreeing": float(len(bad))})
+                      {"poses": float(len(confirmations)), "disagreeing": float(len(bad))}, evidence=evidence)
 
 
 # ------------------------------------------------------------------------------------------
@@ -353,7 +375,7 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
           executor: Executor | None = None, options: Mapping[str, Any] | None = None,
           progress: ProgressFactory = no_progress, overrides: Sequence[str] = (),
           extra_files: Mapping[str, str] | None = None) -> CheckRun:
-    """Build, sweep, apply the mesh-resolution rule, confirm the worst poses on the exact B-rep
+    """Build (meshes fine enough for the design's smallest clearance), sweep, confirm the worst poses on the exact B-rep
     and write report.html, summary.json and sweep.csv beside the CAD — all as one transaction
     (:class:`gearcheck.output.RunFolder`): ``folder`` ends up holding this whole run, or, if
     anything fails or interrupts it, the previous run untouched."""
@@ -363,10 +385,9 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
     with RunFolder(folder) as txn:
         run = _build_into(design, txn.staging, tol_mm, progress, overrides)
         result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
-                       progress=progress)
-        apply_resolution_rule(design, result, run.bodies, run.tol_mm)
+                       progress=progress, mesh_plan=run.mesh_plan)
         result.confirmations = confirm(result, run.parts, run.bodies, progress)
-        result.verdicts.append(confirmation_verdict(result.confirmations))
+        result.verdicts.append(confirmation_verdict(result.confirmations, result.resolution))
         _, summary = write_report(design, txn.staging, result, run.manifest)
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()

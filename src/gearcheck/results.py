@@ -14,6 +14,8 @@ from typing import Any, Literal
 
 Level = Literal["pass", "warn", "fail"]
 LEVELS: tuple[Level, ...] = ("pass", "warn", "fail")
+#: the kinds of evidence a verdict can rest on, most exact first
+EVIDENCE = ("exact B-rep", "exact model", "mesh sweep", "analytical model")
 
 
 @dataclass(frozen=True)
@@ -22,13 +24,16 @@ class Verdict:
 
     ``name`` is its key in summary.json (``verdicts.NAME``: 1 unless the level is "fail"), unique
     within a check; ``label`` says what is claimed, ``measured`` what was measured against which
-    limit, in one line; ``figures`` the deciding numbers, for a program."""
+    limit, in one line; ``figures`` the deciding numbers, for a program; ``evidence`` which
+    evidence decided it, in a few words (one of :data:`EVIDENCE` first: "exact model", "mesh
+    sweep", "exact B-rep", then any detail)."""
 
     name: str
     label: str
     level: Level
     measured: str
     figures: Mapping[str, float] = field(default_factory=dict)
+    evidence: str = ""
 
     def __post_init__(self) -> None:
         if self.level not in LEVELS:
@@ -36,9 +41,15 @@ class Verdict:
 
     @classmethod
     def of(cls, name: str, label: str, passed: bool, measured: str,
-           figures: Mapping[str, float] | None = None) -> Verdict:
+           figures: Mapping[str, float] | None = None, evidence: str = "") -> Verdict:
         """A pass/fail verdict."""
-        return cls(name, label, "pass" if passed else "fail", measured, dict(figures or {}))
+        return cls(name, label, "pass" if passed else "fail", measured, dict(figures or {}), evidence)
+
+    @classmethod
+    def graded(cls, name: str, label: str, level: Level, measured: str,
+               figures: Mapping[str, float] | None = None, evidence: str = "") -> Verdict:
+        """A verdict at any level (pass / warn / fail)."""
+        return cls(name, label, level, measured, dict(figures or {}), evidence)
 
     @property
     def passed(self) -> bool:
@@ -160,6 +171,11 @@ class SweepOutcome:
     smallest_clearance: Clearance | None = None
     timings: dict = field(default_factory=dict)
     data: Any = None
+    # set by the pipeline before the verdicts: False when the meshes' pair bound exceeds 1/10 of
+    # the smallest clearance the design asks to decide (Mechanism.smallest_clearance) and no
+    # practical mesh resolves it; the verdicts on that clearance then rest on the exact model,
+    # confirmed at the worst poses on the exact B-rep, not on the mesh's sign
+    mesh_resolves: bool = True
 
 
 @dataclass
@@ -190,6 +206,8 @@ class CheckResult:
     # None: the mechanism checks no non-zero clearance (zero-backlash contact)
     smallest_clearance: Clearance | None = None
     confirmations: list[Confirmation] = field(default_factory=list)
+    # the mesh-resolution rule as checked on this run's meshes (gearcheck.resolution.Resolution)
+    resolution: Any = None
 
     def __post_init__(self) -> None:
         names = [v.name for v in self.verdicts]
@@ -199,6 +217,12 @@ class CheckResult:
     @property
     def passed(self) -> bool:
         return all(v.passed for v in self.verdicts)
+
+    @property
+    def level(self) -> Level:
+        """The design's level: "fail" if any verdict fails, else "warn" if any warns, else "pass"."""
+        levels = {v.level for v in self.verdicts}
+        return "fail" if "fail" in levels else ("warn" if "warn" in levels else "pass")
 
     @property
     def failed(self) -> list[Verdict]:

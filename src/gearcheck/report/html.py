@@ -20,10 +20,12 @@ h1 { margin-bottom: 0.2em; } h2 { margin-top: 1.6em; border-bottom: 1px solid #d
 .banner { padding: 0.8em 1.2em; border-radius: 6px; font-size: 1.25em; font-weight: 600; }
 .pass { background: #e3f5e6; color: #17612a; border: 1px solid #9fd3a9; }
 .fail { background: #fbe6e6; color: #8a1c1c; border: 1px solid #e3a3a3; }
+.warn { background: #fdf3dc; color: #7a5200; border: 1px solid #e6c77a; }
 table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.93em; }
 th, td { border: 1px solid #d6d9e0; padding: 0.3em 0.6em; text-align: left; vertical-align: top; }
 th { background: #f2f4f8; } td.num { text-align: right; font-variant-numeric: tabular-nums; }
 td.ok { color: #17612a; font-weight: 600; } td.bad { color: #8a1c1c; font-weight: 600; }
+td.warned { color: #7a5200; font-weight: 600; }
 .meta { color: #5a6275; font-size: 0.9em; } .plot { margin: 1em 0; }
 .key { font-size: 0.82em; color: #3a4255; margin: 0.2em 0 0 4em; max-width: 60em; }
 .notes li { margin: 0.3em 0; } code { background: #f2f4f8; padding: 0 0.25em; }
@@ -109,21 +111,25 @@ def plot_svg(plot: Plot) -> str:
 
 def render(result: CheckResult, *, title: str, template: str, build: dict) -> str:
     """The whole page. ``build``: manifest figures (tolerance, triangles, version)."""
-    ok = result.passed
     parts = [f"<!doctype html><html lang='en'><head><meta charset='utf-8'><title>{html.escape(title)}</title>",
              f"<style>{CSS}</style></head><body>"]
     parts.append(f"<h1>{html.escape(title)}</h1>")
     parts.append(f"<p class='meta'>template <code>{html.escape(template)}</code> · gearcheck {__version__} · "
                  f"mesh tolerance {build.get('chordal_tolerance_mm', '')} mm · "
                  f"{build.get('triangles', '')} triangles in {build.get('parts', '')} parts</p>")
-    parts.append(f"<div class='banner {'pass' if ok else 'fail'}'>{'PASS' if ok else 'FAIL'}: "
-                 f"{sum(v.passed for v in result.verdicts)} of {len(result.verdicts)} verdicts pass</div>")
+    level = result.level
+    warned = sum(v.level == "warn" for v in result.verdicts)
+    parts.append(f"<div class='banner {level}'>{level.upper()}: "
+                 f"{sum(v.passed for v in result.verdicts)} of {len(result.verdicts)} verdicts pass"
+                 f"{f' ({warned} with a warning)' if warned else ''}</div>")
 
-    parts.append("<h2>Verdicts</h2><table><tr><th>claim</th><th>result</th><th>measured</th></tr>")
+    parts.append("<h2>Verdicts</h2><table><tr><th>claim</th><th>result</th><th>measured</th>"
+                 "<th>decided by</th></tr>")
     for v in result.verdicts:
         word = {"pass": "pass", "warn": "warn", "fail": "FAIL"}[v.level]
-        parts.append(f"<tr><td>{html.escape(v.label)}</td><td class='{'ok' if v.passed else 'bad'}'>"
-                     f"{word}</td><td>{html.escape(v.measured)}</td></tr>")
+        cls = {"pass": "ok", "warn": "warned", "fail": "bad"}[v.level]
+        parts.append(f"<tr><td>{html.escape(v.label)}</td><td class='{cls}'>"
+                     f"{word}</td><td>{html.escape(v.measured)}</td><td>{html.escape(v.evidence)}</td></tr>")
     parts.append("</table>")
 
     if result.comparisons:

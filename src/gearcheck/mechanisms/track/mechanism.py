@@ -14,7 +14,7 @@ from gearcheck.mechanisms.track.params import Params as TrackParams
 if TYPE_CHECKING:
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
-    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body
 
 
@@ -35,6 +35,11 @@ class TrackDrive(Mechanism):
 
     def assembly(self, params: TrackParams) -> Assembly:
         return track_assembly(params)
+
+    def smallest_clearance(self, params: TrackParams) -> Clearance | None:
+        from gearcheck.mechanisms.track.clearance import least_clearance
+
+        return least_clearance(track_assembly(params).layout)
 
     def parts(self, assembly: Assembly) -> list[Part]:
         from gearcheck.mechanisms.track.parts import build_parts

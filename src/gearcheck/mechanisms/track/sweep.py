@@ -24,7 +24,6 @@ this process.
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import math
 import time
@@ -36,21 +35,20 @@ import numpy as np
 
 from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
-from gearcheck.geometry.track_section import ExactSection
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
 from gearcheck.mechanisms.track import wear as track_wear
 from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
-from gearcheck.results import Clearance, SweepOutcome, WorstPose
+from gearcheck.mechanisms.track.clearance import (CYCLE_MARGIN_FRACTION, STEPS_PER_CYCLE, clearance_of, exact_section,
+                                                  sweep_angles, worn_model)
+from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
 from gearcheck.sweep.engine import Scene
 from gearcheck.sweep.tools import ContactProof, prove_contact
 
-# Sprocket angles per engagement cycle β (step β/60 = 0.245°: a seated pin moves 0.50 mm per step,
-# far less than the 8 mm sleeve, so no body can pass through another between poses).
-STEPS_PER_CYCLE = 60
-# The sweep runs this fraction of a cycle before θ = 0 and after θ = β.
-CYCLE_MARGIN_FRACTION = 0.125
+# Sprocket angles per engagement cycle β: STEPS_PER_CYCLE (60: step β/60 = 0.245°, a seated pin
+# moves 0.50 mm per step, far less than the 8 mm sleeve, so no body can pass through another
+# between poses), and CYCLE_MARGIN_FRACTION of a cycle before θ = 0 and after β (see .clearance).
 DEFAULT_OPTIONS = {"steps_per_cycle": STEPS_PER_CYCLE, "margin_fraction": CYCLE_MARGIN_FRACTION}
 # Contact is judged with this tolerance, or the mesh-error bound if that is larger: pushed by the
 # measured gap − tolerance the pair must be free, by gap + tolerance it must collide.
@@ -82,28 +80,8 @@ def split_link_mesh(mesh: MeshData, sleeve_radius_mm: float,
     return submesh(mesh, SLEEVE, on_sleeve), submesh(mesh, PLATE, ~on_sleeve)
 
 
-def sweep_angles(wrap: tc.ChainWrap, steps_per_cycle: int = STEPS_PER_CYCLE,
-                 margin_fraction: float = CYCLE_MARGIN_FRACTION) -> np.ndarray:
-    """θ from −margin to β + margin in steps of β/steps_per_cycle; 0 and β are samples."""
-    before = int(math.ceil(margin_fraction * steps_per_cycle))
-    k = np.arange(-before, steps_per_cycle + before + 1)
-    return k * wrap.cycle_rad / steps_per_cycle
-
-
 # --------------------------------------------------------------------------------------------
 # The task (runs in worker processes)
-
-_EXACT_CACHE: dict = {}
-
-
-def exact_section(model: TrackModel) -> ExactSection:
-    """One exact model per process and template (workers receive the model with every pose)."""
-    key = model.section_key()
-    if key not in _EXACT_CACHE:
-        _EXACT_CACHE.clear()
-        _EXACT_CACHE[key] = ExactSection(model.gap, model.link)
-    return _EXACT_CACHE[key]
-
 
 def evaluate_pose(scene: Scene, model: TrackModel, angle_rad: float) -> np.ndarray:
     """(links, 5) per link at drive angle θ: mesh sprocket–sleeve distance, mesh sprocket–plate
@@ -170,14 +148,11 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     tasks = [(evaluate_pose, (model, float(a))) for a in angles]
     # the declared chain wear: the same link solids posed by the worn wrap (pins p·(1 + e) apart),
     # at the same angles, confirm the exact model's worn-pitch sweep on the meshes
-    worn_model = None
-    if model.wear_elongation > 0.0:
-        w = model.wrap
-        worn_model = dataclasses.replace(model, wrap=track_wear.worn_wrap(w.teeth, w.pitch_mm,
-                                                                          model.wear_elongation, w))
-        tasks += [(evaluate_pose, (worn_model, float(a))) for a in angles]
+    worn = worn_model(model)
+    if worn is not None:
+        tasks += [(evaluate_pose, (worn, float(a))) for a in angles]
     setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter(),
-                   worn_model)
+                   worn)
     return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts)
 
 
@@ -401,10 +376,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     n_poses = len(angles)
     timings = {"sweep_s": sweep_s, "poses_per_s": n_poses / sweep_s,
                "link_poses_per_s": n_poses * wrap.links / sweep_s, "contact_proof_s": proof_s}
-    clearances = [(v, what) for v, what in ((x["ex_min_sleeve"].value, "least tooth–sleeve clearance"),
-                                            (x["ex_min_plate"].value, "least tip-to-plate distance")) if v > 0.0]
-    least = min(clearances) if clearances else None
-    clearance = Clearance(float(least[0]), f"{least[1]} (exact 2-D)") if least else None
+    clearance = clearance_of(x["ex_min_sleeve"].value, x["ex_min_plate"].value)
     return SweepOutcome(summary(data), worst, clearance, timings, data)
 
 

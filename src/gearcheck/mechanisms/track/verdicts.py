@@ -26,7 +26,12 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     collisions, angles = d.collisions, d.angles
 
     exact_penetration = min(ex_min_sleeve.value, ex_min_plate.value) < 0.0
-    no_interference = collisions == 0 and not exact_penetration
+    # a mesh collision at a clearance the meshes cannot resolve is not evidence: the exact model decides
+    resolved = outcome.mesh_resolves
+    no_interference = (collisions == 0 or not resolved) and not exact_penetration
+    on_mesh = ("mesh sweep (FCL collide at every link pose), exact 2-D model agrees" if resolved else
+               "exact model (2-D section): the meshes cannot resolve the least clearance; exact B-rep at the "
+               "worst poses")
     gap_in_window = (rounded(seated_gap.value) >= model.required_gap_min_mm
                      and rounded(d.seated_gap_max) <= model.required_gap_max_mm)
     min_plate_ok = rounded(min_plate.value) >= model.required_gap_min_mm
@@ -35,39 +40,43 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     agrees = max(d.max_dev, worn_dev) <= bound
     clash = (f"{collisions} colliding link poses, first at θ = {np.degrees(angles[d.colliding_poses[0]]):.3f}°; "
              if collisions else f"FCL collide false at all {len(angles)}×{model.wrap.links} link poses; ")
-    resolved = ("a positive clearance beyond the bound" if min_sleeve.value > bound
-                else "within the bound: a contact, not a resolved clearance")
+    kind = ("a positive clearance beyond the bound" if min_sleeve.value > bound
+            else "within the bound: a contact, not a resolved clearance")
     return [
         Verdict.of("no_interference", "no interference between sprocket and links over the sweep", no_interference,
-                   clash + f"min tooth–sleeve {min_sleeve.value:.4f} mm ({resolved}; exact "
+                   clash + f"min tooth–sleeve {min_sleeve.value:.4f} mm ({kind}; exact "
                    f"{ex_min_sleeve.value:.4f}), min tip–plate {min_plate.value:.4f} mm; bound {bound:.3f} mm",
                    {"collisions": collisions, "min_tooth_sleeve_mm": min_sleeve.value,
                     "exact_min_tooth_sleeve_mm": ex_min_sleeve.value, "min_tip_plate_mm": min_plate.value,
-                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}),
+                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}, evidence=on_mesh),
         Verdict.of("seated_tip_gap_in_window", "seated-link tip gap inside the paper's window", gap_in_window,
                    f"{seated_gap.value:.4f}–{d.seated_gap_max:.4f} mm over {int(d.links_seated.sum())} seated link "
                    f"poses (template {model.tip_gap_mm:g}), window {model.required_gap_min_mm:g}–"
                    f"{model.required_gap_max_mm:g} mm; bound {bound:.3f} mm",
                    {"seated_tip_gap_mm": seated_gap.value, "seated_tip_gap_max_mm": d.seated_gap_max,
-                    "window_min_mm": model.required_gap_min_mm, "window_max_mm": model.required_gap_max_mm}),
+                    "window_min_mm": model.required_gap_min_mm, "window_max_mm": model.required_gap_max_mm},
+                   evidence="mesh sweep (seated links), proven from both sides; exact 2-D model agrees"),
         Verdict.of("min_tip_plate_distance", "tip-to-plate distance over the sweep ≥ the paper's minimum",
                    min_plate_ok,
                    f"min {min_plate.value:.4f} mm at {d.where(min_plate)}, limit ≥ {model.required_gap_min_mm:g} mm; "
                    f"bound {bound:.3f} mm",
-                   {"min_tip_plate_mm": min_plate.value, "limit_mm": model.required_gap_min_mm}),
+                   {"min_tip_plate_mm": min_plate.value, "limit_mm": model.required_gap_min_mm},
+                   evidence="mesh sweep (every link pose); exact 2-D model agrees"),
         Verdict.of("contact_proven", "clearances proven from both sides (free at −tol, contact at +tol)", proofs_hold,
                    f"tip gap: contact at {gap_proof.contact_mm:.5f} mm vs measured {gap_proof.measured_mm:.5f}; "
                    f"seat: contact at {sleeve_proof.contact_mm:.5f} mm vs measured {sleeve_proof.measured_mm:.5f}; "
                    f"tol ±{d.contact_tol:.3f} mm",
                    {"tip_gap_contact_mm": gap_proof.contact_mm, "tip_gap_measured_mm": gap_proof.measured_mm,
                     "seat_contact_mm": sleeve_proof.contact_mm, "seat_measured_mm": sleeve_proof.measured_mm,
-                    "tolerance_mm": d.contact_tol, "bound_mm": bound}),
+                    "tolerance_mm": d.contact_tol, "bound_mm": bound},
+                   evidence="mesh sweep (FCL: pushed by the gap ∓ tolerance)"),
         *_wear_verdicts(d),
         Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with the exact 2-D model at every pose and link",
                    agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm"
                    + ("" if d.worn_mesh is None else f" (worn chain: {worn_dev:.4f} mm)") + f", bound {bound:.3f} mm",
                    {"max_mesh_deviation_mm": d.max_dev, "bound_mm": bound,
-                    **({} if d.worn_mesh is None else {"worn_max_mesh_deviation_mm": worn_dev})}),
+                    **({} if d.worn_mesh is None else {"worn_max_mesh_deviation_mm": worn_dev})},
+                   evidence="mesh sweep against the exact 2-D model"),
     ]
 
 
@@ -89,4 +98,5 @@ def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
         f"±{100 * w.tolerance:.4f} %); at the declared wear the sleeve {seat}, {sweep} "
         f"(exact 2-D model){mesh}",
         {"wear_declared_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
-         "wear_limit_mode": w.mode_code})]
+         "wear_limit_mode": w.mode_code},
+        evidence="exact model (2-D section, bisection on the elongation); mesh sweep at the declared wear")]
