@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.gearcheck-installed
 
-.PHONY: install demo test lint bench fuzz clean
+.PHONY: install demo studies test lint bench fuzz clean
 
 install: $(STAMP)
 
@@ -27,6 +27,12 @@ test: $(STAMP)
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src bench
 	$(VENV)/bin/mypy
+
+# The three shipped tolerance studies at their default sizes (a few minutes): out/study_NAME/
+studies: $(STAMP)
+	$(PY) -m gearcheck study differential_tolerances --out out/study_differential_tolerances
+	$(PY) -m gearcheck study track_wear --out out/study_track_wear
+	$(PY) -m gearcheck study steering_tolerances --out out/study_steering_tolerances
 
 bench: $(STAMP)
 	$(PY) bench/run.py --out out/bench.json

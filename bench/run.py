@@ -23,6 +23,8 @@ from gearcheck.design import load_template  # noqa: E402
 from gearcheck.executor import available_cores  # noqa: E402
 from gearcheck.output import atomic_write_text, ensure_out_dir  # noqa: E402
 
+from study import bench_study  # noqa: E402  (bench/study.py, beside this file)
+
 TEMPLATES = sorted((ROOT / "templates").glob("*.toml"))
 
 
@@ -114,6 +116,7 @@ def main() -> int:
         "build_all_wall": bench_command_all("build", 3),
         "sweep": bench_sweeps(args.repeat_sweep),
         "check_all_wall": bench_command_all("check", args.repeat_sweep),
+        "study": bench_study(),
     }
     atomic_write_text(args.out, json.dumps(result, indent=2) + "\n")
     for group in ("calc", "build"):
@@ -124,6 +127,14 @@ def main() -> int:
         speedup = fig["speedup_all_cores_over_1"]
         print(f"sweep {name:28s} median {fig['median_s']:8.2f} s  ({speedup:.2f}x over 1 worker)")
     print(f"check --all (fresh process)         median {result['check_all_wall']['median_s']:8.2f} s")
+    st = result["study"]
+    for name, fig in st["analytical_batch"].items():
+        print(f"study {name}: analytical, {fig['variants']} variants in {fig['seconds']:.2f} s on one core")
+    for name, fig in st["exact_level"].items():
+        print(f"study {name}: exact level {fig['variants_per_s_per_core']:.2f} variants/s per core")
+    d = st["dask_vs_local"]
+    print(f"study {d['study']}: Dask LocalCluster {d['dask_s']:.1f} s vs local {d['local_s']:.1f} s "
+          f"({d['workers']} workers), rows identical: {d['rows_identical']}")
     print(f"wrote {args.out}")
     return 0
 

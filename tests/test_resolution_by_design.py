@@ -42,3 +42,22 @@ def test_the_iso_minimum_seating_radius_gets_its_exact_verdicts(tmp_path, templa
     assert s["verdict_pass"] == 1
     exact = s["exact"]["min_tooth_sleeve_clearance_mm"]
     assert s["min_tooth_sleeve_clearance_mm"] == pytest.approx(exact, abs=rule["pair_error_bound_mm"])
+
+
+def test_a_play_no_practical_mesh_resolves_is_decided_on_the_exact_evidence(tmp_path, templates_dir):
+    """Differential at shim 0.04 mm: +0.08′ per side at the cold design point on the exact flanks
+    (≈ 1 µm on d1/2) would need 0.05 µm meshes. Not a refusal: the default meshes are kept, the
+    rule is recorded as not met, the play verdicts rest on the exact model, and the worst poses
+    are confirmed on the exact B-rep."""
+    code = main(["check", str(templates_dir / "zhurong_differential.toml"), "--set", "shim.thickness_mm=0.04",
+                 "--out", str(tmp_path)])
+    s = json.loads((tmp_path / "summary.json").read_text())["differential"]
+    rule = s["mesh_resolution"]
+    assert rule["rule_met"] == 0
+    assert rule["resolving_tol_mm"] < 0.0005 < rule["tol_mm"]  # finer than any practical mesh: default kept
+    assert rule["smallest_clearance_mm"] < 0.002
+    assert s["verdict_evidence"]["cold_play_positive"].startswith("exact model")
+    assert s["verdict_levels"]["cold_play_positive"] == "pass"  # +0.08′: free, on the exact flanks
+    assert s["verdict_evidence"]["exact_confirmation"].startswith("exact B-rep: the meshes cannot resolve")
+    assert s["verdict_levels"]["storage_play_positive"] == "warn"
+    assert code == 0  # warnings do not fail a design

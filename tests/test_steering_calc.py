@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import tomllib
 from pathlib import Path
 
@@ -273,3 +274,44 @@ def test_template_is_inputs_only():
     values = [v for section in data.values() if isinstance(section, dict) for v in section.values()]
     for derived in (84.0, 88.0, 23.0, 109.81, 110.20, 62.67, 62.11, 75.32, 25.125):
         assert derived not in values, derived
+
+
+@pytest.mark.parametrize("overrides", [
+    (),
+    ("towing.max_angle_deg=75",),  # the rack is still moving at the end of the swing
+    ("towing.max_angle_deg=60",),  # and the towing-curve points lie beyond the swing
+    ("pinion.topped_radius_mm=82.9",),
+    ("trim.hS2_mm=24.1", "trim.hS6_mm=24.6"),
+    ("trim.min_contact_ratio=1.3",),  # no hS2 solves eq (4)
+    ("targets.continuous_angle_deg=70",),  # no RS1 reaches the target
+])
+def test_calc_json_has_no_null_and_no_nan(capsys, overrides):
+    """calc --json never holds null or NaN: a figure without a value is left out of the JSON and
+    named with its reason ("—") in the table."""
+    args = [a for o in overrides for a in ("--set", o)]
+    assert main(["calc", str(TEMPLATE), *args, "--json"]) == 0
+    text = capsys.readouterr().out
+
+    def no_constant(name):
+        raise AssertionError(f"{name} in calc --json")
+
+    body = json.loads(text, parse_constant=no_constant)["steering"]
+
+    def leaves(tree):
+        for v in tree.values():
+            yield from leaves(v) if isinstance(v, dict) else [v]
+
+    values = list(leaves(body))
+    assert values and all(isinstance(v, (int, float)) and math.isfinite(v) for v in values)
+    figures = load_template(TEMPLATE, list(overrides)).calc().figures
+    assert {f.key for f in figures} == set(body) - {"paper"}  # every figure calc gives is in the JSON
+    assert main(["calc", str(TEMPLATE), *args]) == 0
+    table = capsys.readouterr().out
+    assert not re.search(r"\bnan\b", table, re.IGNORECASE)
+    left_out = {"disengage_angle_deg", "towing_travel_mm_at_068deg", "RS1_solved_mm", "hS2_solved_mm"} - set(body)
+    if left_out:  # each figure left out is named in the table with its reason
+        assert ": — (" in table
+    if "towing.max_angle_deg=75" in overrides:
+        assert "disengage_angle_deg" not in body and "rack is still moving at towing.max_angle_deg = 75°" in table
+    if "towing.max_angle_deg=60" in overrides:
+        assert "towing_travel_mm_at_068deg" not in body and "beyond towing.max_angle_deg = 60°" in table

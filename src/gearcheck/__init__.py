@@ -6,6 +6,7 @@ As a library::
     d = gearcheck.load("templates/zhurong_differential.toml", overrides={"shim.thickness_mm": 0.15})
     d.calc().to_dict()            # the analytical model (numpy only)
     r = d.check(out="out/x")      # CAD, meshes, sweep, report files; r.passed, r.verdicts, r.summary
+    s = gearcheck.study("differential_tolerances.toml", samples=512, out="out/study")  # s.table, s.summary
 
 ``import gearcheck``, :func:`load` and ``calc`` import neither CadQuery nor FCL: everything
 below is imported on first use.
@@ -19,13 +20,15 @@ from typing import TYPE_CHECKING, Any
 __version__ = "0.1.0"
 
 __all__ = [
-    "CheckResult", "Comparison", "Design", "Mechanism", "ParamError", "Plot", "Verdict", "WorstPose",
-    "__version__", "load", "mechanism_names",
+    "CheckResult", "Comparison", "Design", "Mechanism", "ParamError", "Plot", "StudyResult", "Verdict", "WorstPose",
+    "__version__", "load", "mechanism_names", "study",
 ]
 
 # name → (module, attribute); resolved lazily by __getattr__
 _LAZY = {
     "load": ("gearcheck.design", "load"),
+    "study": ("gearcheck.studies.core", "study"),
+    "StudyResult": ("gearcheck.studies.core", "StudyResult"),
     "Design": ("gearcheck.design", "Design"),
     "ParamError": ("gearcheck.params.common", "ParamError"),
     "Mechanism": ("gearcheck.mechanism", "Mechanism"),
@@ -41,6 +44,7 @@ if TYPE_CHECKING:
     from gearcheck.mechanism import Mechanism
     from gearcheck.params.common import ParamError
     from gearcheck.results import CheckResult, Comparison, Plot, Verdict, WorstPose
+    from gearcheck.studies.core import StudyResult, study
 
 
 def mechanism_names() -> list[str]:

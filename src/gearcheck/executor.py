@@ -1,4 +1,4 @@
-"""Where independent tasks run: in this process, in a pool of local processes, or (later) on a
+"""Where independent tasks run: in this process, in a pool of local processes, or on a Dask
 cluster. One seam, so a check gives the same results, in the same order, on any of them.
 
 A task is ``fn(state, *args)``: ``fn`` a module-level function (pickled by name), ``state`` made
@@ -158,6 +158,71 @@ class ProcessExecutor:
                 out.append(result)
                 _advance(progress, weights, i)
             return out
+
+
+_dask_states: dict[str, Any] = {}
+
+
+def _dask_task(fn: Callable[..., Any], token: str, setup: Callable[[Any], Any] | None, shared: Any,
+               args: tuple) -> Any:
+    """One task on a Dask worker: the worker's state for this map (made once per worker and map,
+    by ``setup(shared)``), then ``fn(state, *args)``."""
+    if token not in _dask_states:
+        _dask_states.clear()  # one map at a time per worker: drop the last one's state
+        _dask_states[token] = setup(shared) if setup is not None else shared
+    return fn(_dask_states[token], *args)
+
+
+class DaskExecutor:
+    """Tasks on a Dask distributed cluster: an existing scheduler (``tcp://HOST:PORT``), or a
+    ``LocalCluster`` of ``jobs`` single-threaded worker processes started here
+    (``"local-cluster"``). Workers import gearcheck from their own environment (it must be
+    installed there, the same version); tasks travel as module-level functions and plain data.
+    Results come back in task order, like every executor. Use as a context manager: a cluster
+    started here is shut down on leaving."""
+
+    def __init__(self, scheduler: str, jobs: int | None = None):
+        from distributed import Client, LocalCluster
+
+        self._cluster = None
+        if scheduler == "local-cluster":
+            n = available_cores() if jobs is None else int(jobs)
+            if n < 1:
+                raise ValueError(f"jobs must be at least 1, got {n}")
+            self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                         dashboard_address=None, silence_logs=logging.ERROR)
+            self.client = Client(self._cluster)
+        else:
+            self.client = Client(scheduler, timeout="20s")
+        self.jobs = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
+
+    def __enter__(self) -> DaskExecutor:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None) -> list:
+        import uuid
+
+        from distributed import as_completed
+
+        tasks = list(tasks)
+        if not tasks:
+            return []
+        token = uuid.uuid4().hex
+        shared_ref = self.client.scatter(shared, broadcast=True) if shared is not None else None
+        futures = [self.client.submit(_dask_task, fn, token, setup, shared_ref, tuple(a), pure=False,
+                                      key=f"gearcheck-{token}-{i}") for i, a in enumerate(tasks)]
+        index = {f.key: i for i, f in enumerate(futures)}
+        for done in as_completed(futures):
+            _advance(progress, weights, index[done.key])
+        return self.client.gather(futures)
 
 
 def make_executor(jobs: int | None = None) -> Executor:

@@ -172,6 +172,24 @@ class Mechanism(ABC):
     def report(self, params: Any, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
         """Rows for sweep.csv, comparison rows, plots and notes for report.html."""
 
+    # -- studies ------------------------------------------------------------------------------
+    def study_row(self, params: Any, level: str) -> dict[str, float]:
+        """One variant's figures for a study (numpy only, no CAD, no mesh): at level
+        "analytical" the analytical model (default: every numeric ``calc`` figure), at level
+        "exact" the exact model (default: none). Keys are plain names; the study prefixes the
+        level."""
+        if level == "analytical":
+            return {f.key: float(f.value) for f in self.analyse(params)
+                    if isinstance(f.value, (int, float)) and not isinstance(f.value, bool)}
+        return {}
+
+    def study_batch(self, params: Any, columns: Mapping[str, np.ndarray]) -> dict[str, np.ndarray] | None:
+        """The analytical level vectorised over many variants (optional): ``params`` the
+        template's, ``columns`` the sampled fields (``section.key`` → one value per variant, all
+        of them validated). Returns the same keys as ``study_row(..., "analytical")`` as arrays,
+        or None to be evaluated variant by variant."""
+        return None
+
     # -- fuzzing ------------------------------------------------------------------------------
     def sample(self, data: dict, draw: Any) -> None:
         """Redraw the knobs of a template body in place (``draw``: a

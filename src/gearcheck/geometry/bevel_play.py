@@ -32,6 +32,7 @@ Angles: radians inside; :func:`arcmin` converts. Play is measured on the big gea
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,6 +67,8 @@ REFINE_GRID = 5
 REFINE_CANDIDATES = 2
 # Points of a flank at the other gear's zone boundary count as inside within this (mm / rad).
 ZONE_TOL = 1e-9
+# big_gear_contacts solves this many pairs per vectorised batch (memory: ~1 MB of points per pair).
+BATCH_PAIRS = 48
 
 
 def arcmin(angle_rad):
@@ -135,7 +138,7 @@ class Play:
 
 
 # -- geometry of one flank ------------------------------------------------------------------
-def _flank_points(spec: BevelGearSpec, scale: float, tooth, side: int, profile, ruling) -> np.ndarray:
+def _flank_points(spec: BevelGearSpec, scale, tooth, side: int, profile, ruling) -> np.ndarray:
     """Points (…, 3), gear frame, of tooth ``tooth``'s flank ``side`` at parameters profile ∈
     [0, 1] (polar angle root cone → tip cone) and ruling ∈ [0, 1] (front cone → back cone)."""
     tooth, profile, ruling = np.broadcast_arrays(np.asarray(tooth, float), np.asarray(profile, float),
@@ -160,10 +163,11 @@ def _signed_to_flank(spec: BevelGearSpec, q: np.ndarray, tooth: np.ndarray, side
     return minus_flank_signed(spec, np.stack([x, y, q[:, 2]], axis=-1))
 
 
-def _in_tooth_zone(spec: BevelGearSpec, scale: float, q: np.ndarray) -> np.ndarray:
-    """Points (gear frame) between the root and tip cones and between the front and back cones:
-    only there can a point be inside a tooth (under the root cone is the blank: tip–root
-    clearance is 0.25·m, far beyond any displacement studied)."""
+def _in_tooth_zone(spec: BevelGearSpec, scale, q: np.ndarray) -> np.ndarray:
+    """Points (gear frame, (…, 3)) between the root and tip cones and between the front and back
+    cones of a gear scaled by ``scale`` (broadcast over the points): only there can a point be
+    inside a tooth (under the root cone is the blank: tip–root clearance is 0.25·m, far beyond
+    any displacement studied)."""
     r = np.linalg.norm(q, axis=-1)
     theta = np.arctan2(np.hypot(q[..., 0], q[..., 1]), q[..., 2])
     along = r * np.cos(theta - spec.pitch_angle_rad)
@@ -184,91 +188,104 @@ def _window_teeth(spec: BevelGearSpec, zone_azimuth: float, window: int) -> np.n
 
 
 def _facing_tooth(spec: BevelGearSpec, q: np.ndarray, side: int) -> np.ndarray:
-    """Index of the tooth whose flank ``side`` faces each point: the tooth space on side s of
-    tooth k is centred at azimuth k·p + s·p/2."""
+    """Index of the tooth whose flank ``side`` faces each point (…, 3): the tooth space on side
+    s of tooth k is centred at azimuth k·p + s·p/2."""
     pitch = spec.angular_pitch_rad
-    az = np.arctan2(q[:, 1], q[:, 0])
+    az = np.arctan2(q[..., 1], q[..., 0])
     return np.round((az - side * pitch / 2.0) / pitch)
+
+
+def _turn_z(p: np.ndarray, angle) -> np.ndarray:
+    """Points (…, 3) turned by ``angle`` (broadcast over the points) about z."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.stack([c * p[..., 0] - s * p[..., 1], s * p[..., 0] + c * p[..., 1], p[..., 2]], axis=-1)
 
 
 # -- contact roots -------------------------------------------------------------------------
 class _FlankSet:
     """Points of one gear's flank (one side) that move, as the big gear turns by δ, against the
     other gear's flank cone of the same side: q(δ) = Rz(−δ)^a · C · Rz(δ)^b · p in the other
-    gear's frame (a = 1 when the other gear is the big one, b = 1 when this one is)."""
+    gear's frame (a = 1 when the other gear is the big one, b = 1 when this one is).
 
-    def __init__(self, this: PlacedGear, other: PlacedGear, this_is_big: bool, side: int, window: int):
-        self.this, self.other, self.big, self.side = this, other, this_is_big, side
-        self.relative = np.linalg.inv(other.pose) @ this.pose  # this frame → other frame
-        self.teeth = _window_teeth(this.spec, _zone_azimuth(this, other), window)
+    Batched: N pairs of the same two designs, each with its own poses and scales. Every array of
+    points or parameters has the shape (N, K, …): K points of pair n in row n."""
 
-    def to_other(self, p: np.ndarray, delta: np.ndarray) -> np.ndarray:
+    def __init__(self, this: Sequence[PlacedGear], other: Sequence[PlacedGear], this_is_big: bool, side: int,
+                 window: int):
+        self.spec, self.other_spec = this[0].spec, other[0].spec
+        self.big, self.side = this_is_big, side
+        relative = np.stack([np.linalg.inv(o.pose) @ t.pose for t, o in zip(this, other, strict=True)])
+        self.rot_t = np.ascontiguousarray(np.transpose(relative[:, :3, :3], (0, 2, 1)))  # this → other frame
+        self.shift = relative[:, None, :3, 3]
+        self.scale = np.array([t.scale for t in this])[:, None]
+        self.other_scale = np.array([o.scale for o in other])[:, None]
+        self.teeth = np.stack([_window_teeth(self.spec, _zone_azimuth(t, o), window)
+                               for t, o in zip(this, other, strict=True)])
+
+    def to_other(self, p: np.ndarray, delta) -> np.ndarray:
         if self.big:  # this gear turns: rotate its points first
-            c, s = np.cos(delta), np.sin(delta)
-            p = np.stack([c * p[:, 0] - s * p[:, 1], s * p[:, 0] + c * p[:, 1], p[:, 2]], axis=-1)
-        q = p @ self.relative[:3, :3].T + self.relative[:3, 3]
+            p = _turn_z(p, delta)
+        q = p @ self.rot_t + self.shift
         if not self.big:  # the other (big) gear turns by δ: undo it in its frame
-            c, s = np.cos(-delta), np.sin(-delta)
-            q = np.stack([c * q[:, 0] - s * q[:, 1], s * q[:, 0] + c * q[:, 1], q[:, 2]], axis=-1)
+            q = _turn_z(q, -np.asarray(delta))
         return q
 
-    def _points(self, tooth, profile, ruling) -> np.ndarray:
-        return _flank_points(self.this.spec, self.this.scale, tooth, self.side, profile, ruling).reshape(-1, 3)
+    def points(self, tooth, profile, ruling) -> np.ndarray:
+        return _flank_points(self.spec, self.scale, tooth, self.side, profile, ruling)
+
+    def _distance(self, q: np.ndarray, facing: np.ndarray) -> np.ndarray:
+        return _signed_to_flank(self.other_spec, q.reshape(-1, 3), facing.reshape(-1), self.side).reshape(q.shape[:-1])
 
     def estimate(self, tooth, profile, ruling, direction: int) -> np.ndarray:
         """One secant step from δ = 0: the turn at which each point would reach the other
         gear's flank cone (d is nearly linear in δ); ±inf where it cannot (moving away, out of
         the other's tooth zone or beyond MAX_CONTACT_ANGLE_RAD). For ranking samples."""
-        p = self._points(tooth, profile, ruling)
-        spec_o = self.other.spec
-        q0 = self.to_other(p, np.zeros(len(p)))
-        facing = _facing_tooth(spec_o, q0, self.side)
-        step = np.full(len(p), direction * SECANT_FIRST_STEP_RAD)
-        d0 = _signed_to_flank(spec_o, q0, facing, self.side)
-        d1 = _signed_to_flank(spec_o, self.to_other(p, step), facing, self.side)
+        p = self.points(tooth, profile, ruling)
+        q0 = self.to_other(p, 0.0)
+        facing = _facing_tooth(self.other_spec, q0, self.side)
+        step = direction * SECANT_FIRST_STEP_RAD
+        d0 = self._distance(q0, facing)
+        d1 = self._distance(self.to_other(p, step), facing)
         slope = (d1 - d0) / step
         with np.errstate(divide="ignore", invalid="ignore"):
             delta = np.where(direction * slope < 0.0, -d0 / slope, np.nan)
         ok = np.isfinite(delta) & (np.abs(delta) < MAX_CONTACT_ANGLE_RAD)
         delta = np.where(ok, delta, 0.0)
-        ok &= _in_tooth_zone(spec_o, self.other.scale, self.to_other(p, delta))
+        ok &= _in_tooth_zone(self.other_spec, self.other_scale, self.to_other(p, delta))
         return np.where(ok, delta, direction * np.inf)
 
     def roots(self, tooth, profile, ruling, direction: int) -> np.ndarray:
         """Turn δ (rad) at which each point reaches the other gear's flank cone inside its tooth
-        zone (secant solve to ROOT_TOL_MM); ±inf (sign of direction) where there is none within
-        MAX_CONTACT_ANGLE_RAD."""
-        p = self._points(tooth, profile, ruling)
-        spec_o = self.other.spec
-        facing = _facing_tooth(spec_o, self.to_other(p, np.zeros(len(p))), self.side)
+        zone (secant solve to ROOT_TOL_MM; a converged point stays put); ±inf (sign of
+        direction) where there is none within MAX_CONTACT_ANGLE_RAD."""
+        p = self.points(tooth, profile, ruling)
+        facing = _facing_tooth(self.other_spec, self.to_other(p, 0.0), self.side)
 
         def dist(delta):
-            return _signed_to_flank(spec_o, self.to_other(p, delta), facing, self.side)
+            return self._distance(self.to_other(p, delta), facing)
 
-        a = np.zeros(len(p))
+        a = np.zeros(p.shape[:-1])
         fa = dist(a)
-        b = np.full(len(p), direction * SECANT_FIRST_STEP_RAD)
+        b = np.full(p.shape[:-1], direction * SECANT_FIRST_STEP_RAD)
         fb = dist(b)
         slope = (fb - fa) / (b - a)
         for _ in range(SECANT_ITERATIONS):
+            active = np.abs(fb) >= ROOT_TOL_MM
+            if not active.any():
+                break
             with np.errstate(divide="ignore", invalid="ignore"):
                 c = b - fb / slope
-            c = np.where(np.isfinite(c) & (np.abs(c) < 10 * MAX_CONTACT_ANGLE_RAD), c, b)
+            c = np.where(active & np.isfinite(c) & (np.abs(c) < 10 * MAX_CONTACT_ANGLE_RAD), c, b)
             moved = c != b
-            a, fa, b = b, fb, c
-            fb = dist(b)
+            fc = dist(c)
             with np.errstate(divide="ignore", invalid="ignore"):
-                slope = np.where(moved, (fb - fa) / (b - a), slope)
-            if np.all(~moved | (np.abs(fb) < ROOT_TOL_MM)):
-                break
+                slope = np.where(moved, (fc - fb) / (c - b), slope)
+            a, fa = np.where(moved, b, a), np.where(moved, fb, fa)
+            b, fb = c, np.where(moved, fc, fb)
         ok = (np.abs(fb) < 1e3 * ROOT_TOL_MM) & (np.abs(b) < MAX_CONTACT_ANGLE_RAD)
         ok &= direction * slope < 0.0  # approaching the cone as the big gear turns this way
-        ok &= _in_tooth_zone(spec_o, self.other.scale, self.to_other(p, b))
+        ok &= _in_tooth_zone(self.other_spec, self.other_scale, self.to_other(p, b))
         return np.where(ok, b, direction * np.inf)
-
-
-class _WindowTooNarrow(RuntimeError):
-    """The extreme lies on the last tooth sampled: a tooth beyond it may touch first."""
 
 
 def teeth_window(big: BevelGearSpec, small: BevelGearSpec) -> int:
@@ -278,84 +295,136 @@ def teeth_window(big: BevelGearSpec, small: BevelGearSpec) -> int:
     return min(max(MIN_TEETH_WINDOW, math.ceil(reach) + 1), MAX_TEETH_WINDOW)
 
 
-def _first_contact(sets: list[_FlankSet], direction: int) -> Contact:
-    """Extreme root over both flank sets (min for +, max for −): samples ranked by a one-step
-    estimate, the best REFINE_CANDIDATES per set (separate local extremes: another tooth or two
-    cells apart) refined on a shrinking local grid of the flank parameters and solved."""
+def _candidates(key: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Per pair (row), the REFINE_CANDIDATES smallest keys of a (N, teeth, profile, ruling) grid
+    that are separate local extremes (another tooth, or more than two cells apart on the same
+    tooth): their flat grid indices (N, C) and whether each is finite (N, C)."""
+    n = key.shape[0]
+    flat = key.reshape(n, -1)
+    ii, jj, mm = np.unravel_index(np.arange(flat.shape[1]), key.shape[1:])
+    excluded = np.zeros(flat.shape, dtype=bool)
+    rows = np.arange(n)
+    picked, valid = [], []
+    for _ in range(REFINE_CANDIDATES):
+        masked = np.where(excluded, np.inf, flat)
+        f = np.argmin(masked, axis=1)
+        picked.append(f)
+        valid.append(np.isfinite(masked[rows, f]))
+        excluded |= ((ii[None, :] == ii[f][:, None]) & (np.abs(jj[None, :] - jj[f][:, None]) <= 2)
+                     & (np.abs(mm[None, :] - mm[f][:, None]) <= 2))
+    return np.stack(picked, axis=1), np.stack(valid, axis=1)
+
+
+def _refine(fs: _FlankSet, centres: np.ndarray, valid: np.ndarray, dt: float, du: float, direction: int):
+    """Local grid search for the extreme root around each candidate (tooth, profile, ruling) —
+    centres (N, C, 3), all in one evaluation per level, the cell shrinking each level. Grid
+    points are ranked by the one-step estimate; the winners are then solved to ROOT_TOL_MM.
+    Returns per pair the best solved key (direction·δ, inf if none) and its tooth, profile, ruling."""
+    grid = np.linspace(-1.0, 1.0, REFINE_GRID)
+    gt, gu = (g.reshape(-1) for g in np.meshgrid(grid, grid, indexing="ij"))
+    n, c = valid.shape
+    centres = centres.copy()
+    keys = np.full((n, c), np.inf)
+    for _ in range(REFINE_LEVELS):
+        T = np.clip(centres[..., 1, None] + dt * gt, 0.0, 1.0)  # (N, C, G²)
+        U = np.clip(centres[..., 2, None] + du * gu, 0.0, 1.0)
+        K = np.broadcast_to(centres[..., 0, None], T.shape)
+        key = (direction * fs.estimate(K.reshape(n, -1), T.reshape(n, -1), U.reshape(n, -1),
+                                       direction)).reshape(T.shape)
+        i = np.argmin(key, axis=2)[..., None]
+        k_best = np.take_along_axis(key, i, axis=2)[..., 0]
+        better = k_best < keys
+        keys = np.where(better, k_best, keys)
+        centres[..., 1] = np.where(better, np.take_along_axis(T, i, axis=2)[..., 0], centres[..., 1])
+        centres[..., 2] = np.where(better, np.take_along_axis(U, i, axis=2)[..., 0], centres[..., 2])
+        dt, du = 2.0 * dt / (REFINE_GRID - 1), 2.0 * du / (REFINE_GRID - 1)
+    solved = direction * fs.roots(centres[..., 0], centres[..., 1], centres[..., 2], direction)
+    solved = np.where(valid, solved, np.inf)
+    j = np.argmin(solved, axis=1)
+    rows = np.arange(n)
+    return solved[rows, j], centres[rows, j, 0], centres[rows, j, 1], centres[rows, j, 2]
+
+
+def _first_contacts(sets: list[_FlankSet], direction: int):
+    """Extreme root over both flank sets (min for +, max for −), per pair: samples ranked by a
+    one-step estimate, the best REFINE_CANDIDATES per set (separate local extremes: another tooth
+    or two cells apart) refined on a shrinking local grid of the flank parameters and solved.
+    Returns per pair: direction·δ (inf: no contact), tooth, profile, ruling, the winning set's
+    index, and whether the winner lies on the outermost sampled tooth (the window is too narrow:
+    a tooth beyond it may touch first)."""
     t = np.linspace(0.0, 1.0, PROFILE_SAMPLES)
     u = np.linspace(0.0, 1.0, RULING_SAMPLES)
     dt, du = 1.0 / (PROFILE_SAMPLES - 1), 1.0 / (RULING_SAMPLES - 1)
-    best = None  # (key, tooth, profile, ruling, set)
-    for fs in sets:
-        k, tt, uu = np.meshgrid(fs.teeth, t, u, indexing="ij")
-        key = direction * fs.estimate(k, tt, uu, direction).reshape(k.shape)
-        order = np.argsort(key, axis=None)
-        picked: list[tuple[int, int, int]] = []  # grid indices (tooth, profile, ruling)
-        for flat in order[: 50 * REFINE_CANDIDATES]:
-            if not np.isfinite(key.flat[flat]) or len(picked) == REFINE_CANDIDATES:
-                break
-            idx = np.unravel_index(flat, key.shape)
-            # a separate local extreme: another tooth, or two cells away on the same tooth
-            if any(i == idx[0] and abs(j - idx[1]) <= 2 and abs(m - idx[2]) <= 2 for i, j, m in picked):
-                continue
-            picked.append((int(idx[0]), int(idx[1]), int(idx[2])))
-        cands = [(float(fs.teeth[i]), float(t[j]), float(u[m])) for i, j, m in picked]
-        if not cands:
+    n = sets[0].teeth.shape[0]
+    rows = np.arange(n)
+    best = np.full(n, np.inf)
+    tooth, tb, ub = np.zeros(n), np.zeros(n), np.zeros(n)
+    which = np.zeros(n, dtype=int)
+    for s, fs in enumerate(sets):
+        nk = fs.teeth.shape[1]
+        shape = (n, nk, len(t), len(u))
+        K = np.broadcast_to(fs.teeth[:, :, None, None], shape).reshape(n, -1)
+        T = np.broadcast_to(t[None, None, :, None], shape).reshape(n, -1)
+        U = np.broadcast_to(u[None, None, None, :], shape).reshape(n, -1)
+        key = (direction * fs.estimate(K, T, U, direction)).reshape(shape)
+        flat, valid = _candidates(key)
+        if not valid.any():
             continue
-        cand = _refine(fs, np.array(cands), dt, du, direction)
-        if best is None or cand[0] < best[0]:
-            best = cand + (fs,)
-    if best is None or not np.isfinite(best[0]):
-        raise RuntimeError("no contact within MAX_CONTACT_ANGLE_RAD: the gears are not in mesh")
-    key, tooth, tb, ub, fs = best
-    if tooth in (fs.teeth[0], fs.teeth[-1]):
-        raise _WindowTooNarrow(f"contact on the outermost sampled tooth ({'big' if fs.big else 'small'} "
-                               f"tooth {tooth})")
-    delta = direction * key
-    p = fs._points(tooth, tb, ub)
-    pose = fs.this.turned(delta).pose if fs.big else fs.this.pose
-    point = pose[:3, :3] @ p[0] + pose[:3, 3]
-    return Contact(float(delta), point, "big" if fs.big else "small", int(tooth), tb, ub)
+        i, j, m = np.unravel_index(flat, shape[1:])
+        centres = np.stack([np.take_along_axis(fs.teeth, i, axis=1).astype(float), t[j], u[m]], axis=-1)
+        k_s, tooth_s, tb_s, ub_s = _refine(fs, centres, valid, dt, du, direction)
+        better = k_s < best
+        best = np.where(better, k_s, best)
+        tooth, tb, ub = np.where(better, tooth_s, tooth), np.where(better, tb_s, tb), np.where(better, ub_s, ub)
+        which = np.where(better, s, which)
+    teeth = np.stack([fs.teeth for fs in sets])[which, rows]  # (N, window teeth) of each winner
+    narrow = np.isfinite(best) & ((tooth == teeth[:, 0]) | (tooth == teeth[:, -1]))
+    return best, tooth, tb, ub, which, narrow
 
 
-def _refine(fs: _FlankSet, cands: np.ndarray, dt: float, du: float, direction: int):
-    """Local grid search for the extreme root around each candidate (tooth, profile, ruling),
-    all candidates in one evaluation per level, the cell shrinking each level. Grid points are
-    ranked by the one-step estimate; the winner is then solved to ROOT_TOL_MM."""
-    grid = np.linspace(-1.0, 1.0, REFINE_GRID)
-    gt, gu = np.meshgrid(grid, grid, indexing="ij")
-    centres = cands.copy()
-    keys = np.full(len(cands), np.inf)
-    rows = np.arange(len(cands))
-    for _ in range(REFINE_LEVELS):
-        T = np.clip(centres[:, 1, None, None] + dt * gt, 0.0, 1.0)
-        U = np.clip(centres[:, 2, None, None] + du * gu, 0.0, 1.0)
-        K = np.broadcast_to(centres[:, 0, None, None], T.shape)
-        key = (direction * fs.estimate(K, T, U, direction)).reshape(len(cands), -1)
-        i = np.argmin(key, axis=1)
-        better = key[rows, i] < keys
-        keys = np.where(better, key[rows, i], keys)
-        centres[better, 1] = T.reshape(len(cands), -1)[better, i[better]]
-        centres[better, 2] = U.reshape(len(cands), -1)[better, i[better]]
-        dt, du = 2.0 * dt / (REFINE_GRID - 1), 2.0 * du / (REFINE_GRID - 1)
-    solved = direction * fs.roots(centres[:, 0], centres[:, 1], centres[:, 2], direction)
-    j = int(np.argmin(solved))
-    return float(solved[j]), int(centres[j, 0]), float(centres[j, 1]), float(centres[j, 2])
+def big_gear_contacts(bigs: Sequence[PlacedGear], smalls: Sequence[PlacedGear], direction: int) -> list[Contact]:
+    """:func:`big_gear_contact` for many pairs at once (the same two designs; each pair its own
+    poses and scales), vectorised over the pairs in chunks of :data:`BATCH_PAIRS`."""
+    if direction not in (-1, 1):
+        raise ValueError("direction must be +1 or -1")
+    if len(bigs) != len(smalls):
+        raise ValueError("one small gear per big gear")
+    if not bigs:
+        return []
+    big_spec, small_spec = bigs[0].spec, smalls[0].spec
+    if any(b.spec != big_spec for b in bigs) or any(s.spec != small_spec for s in smalls):
+        raise ValueError("a batch holds pairs of the same two gear designs")
+    out: list[Contact | None] = [None] * len(bigs)
+    side = direction  # + direction: side +1 flanks of both gears (module docstring)
+    for start in range(0, len(bigs), BATCH_PAIRS):
+        todo = np.arange(start, min(start + BATCH_PAIRS, len(bigs)))
+        window = teeth_window(big_spec, small_spec)
+        while todo.size:
+            if window > MAX_TEETH_WINDOW:
+                raise RuntimeError(f"contact on the outermost sampled tooth with {MAX_TEETH_WINDOW} teeth on either "
+                                   "side of the mesh zone")
+            b = [bigs[int(i)] for i in todo]
+            s = [smalls[int(i)] for i in todo]
+            sets = [_FlankSet(b, s, True, side, window), _FlankSet(s, b, False, side, window)]
+            key, tooth, tb, ub, which, narrow = _first_contacts(sets, direction)
+            if not np.all(np.isfinite(key)):
+                raise RuntimeError("no contact within MAX_CONTACT_ANGLE_RAD: the gears are not in mesh")
+            for k in np.flatnonzero(~narrow):
+                this = b[k] if which[k] == 0 else s[k]
+                delta = direction * float(key[k])
+                p = _flank_points(this.spec, this.scale, tooth[k], side, tb[k], ub[k])
+                pose = this.turned(delta).pose if which[k] == 0 else this.pose
+                out[todo[k]] = Contact(delta, pose[:3, :3] @ p + pose[:3, 3], "big" if which[k] == 0 else "small",
+                                       int(tooth[k]), float(tb[k]), float(ub[k]))
+            todo = todo[narrow]
+            window += 1
+    return [c for c in out if c is not None]
 
 
 def big_gear_contact(big: PlacedGear, small: PlacedGear, direction: int) -> Contact:
     """Turn of the big gear about its own axis (from its given pose) at which it first touches
     the small gear, turning + (direction = +1) or − (−1)."""
-    if direction not in (-1, 1):
-        raise ValueError("direction must be +1 or -1")
-    side = direction  # + direction: side +1 flanks of both gears (module docstring)
-    for window in range(teeth_window(big.spec, small.spec), MAX_TEETH_WINDOW + 1):
-        sets = [_FlankSet(big, small, True, side, window), _FlankSet(small, big, False, side, window)]
-        try:
-            return _first_contact(sets, direction)
-        except _WindowTooNarrow as exc:
-            reason = exc
-    raise RuntimeError(f"{reason} with {MAX_TEETH_WINDOW} teeth on either side of the mesh zone")
+    return big_gear_contacts([big], [small], direction)[0]
 
 
 def big_gear_play(big: PlacedGear, small: PlacedGear) -> Play:

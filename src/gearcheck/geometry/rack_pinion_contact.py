@@ -49,6 +49,8 @@ class ContinuousDrive:
     event: str  # e.g. "towing: G1's conjugate contact ends (at S1, its tip corner)"
     gap_rad: tuple[float, float] | None  # (last contact ends, next begins) when a hand-over gap decides it
     pairs: tuple[PairContact, ...]
+    # every hand-over on the way, (the earlier pair's contact ends, the next one's begins), the gap last
+    handovers: tuple[tuple[float, float], ...] = ()
 
     @property
     def angle_deg(self) -> float:
@@ -88,14 +90,13 @@ def pair_contact(g: RackPinionGeometry, mode: str, j: int, k: int) -> PairContac
     tip_t = math.sqrt(max(r_tip ** 2 - rb ** 2, 0.0)) - r * sa
     form_t = math.sqrt(max(r_form ** 2 - rb ** 2, 0.0)) - r * sa
     left, right = g.rack_corner_heights(k)
-    gname = pinion_name(g, j)
     if mode == "towing":
-        starts = [(-(left - h) / sa, f"at {rack_corner_name(g, k, -1)}"), (form_t, f"on {gname}'s form circle")]
-        ends = [(tip_t, f"at {pinion_corner_name(g, j)}"), (root_t, "at the rack root")]
+        starts = [(-(left - h) / sa, "rack_top"), (form_t, "pinion_form")]
+        ends = [(tip_t, "pinion_tip"), (root_t, "rack_root")]
         sign = +1.0
     elif mode == "power":
-        starts = [(-tip_t, f"at {gname}'s tip corner"), (-root_t, "at the rack root")]
-        ends = [((right - h) / sa, f"at {rack_corner_name(g, k, +1)}"), (-form_t, f"on {gname}'s form circle")]
+        starts = [(-tip_t, "pinion_tip"), (-root_t, "rack_root")]
+        ends = [((right - h) / sa, "rack_top"), (-form_t, "pinion_form")]
         sign = -1.0
     else:
         raise ValueError(f"mode {mode!r} is not one of {MODES}")
@@ -105,7 +106,20 @@ def pair_contact(g: RackPinionGeometry, mode: str, j: int, k: int) -> PairContac
     def phi(t: float) -> float:
         return (t / ca - k * g.pitch + sign * w0) / r
 
-    return PairContact(mode, j, k, phi(t0), phi(t1), by0, by1)
+    return PairContact(mode, j, k, phi(t0), phi(t1), end_name(g, mode, j, k, by0), end_name(g, mode, j, k, by1))
+
+
+def end_name(g: RackPinionGeometry, mode: str, j: int, k: int, which: str) -> str:
+    """How a pair's conjugate contact starts or ends, by the flank end that decides it (``which``:
+    "rack_top", "rack_root", "pinion_tip" or "pinion_form"), e.g. "at S2", "at S1, G1's tip corner"."""
+    gname = pinion_name(g, j)
+    names = {
+        "rack_top": f"at {rack_corner_name(g, k, -1 if mode == 'towing' else +1)}",
+        "rack_root": "at the rack root",
+        "pinion_tip": f"at {pinion_corner_name(g, j)}" if mode == "towing" else f"at {gname}'s tip corner",
+        "pinion_form": f"on {gname}'s form circle",
+    }
+    return names[which]
 
 
 def pair_contacts(g: RackPinionGeometry, mode: str) -> list[PairContact]:
@@ -119,27 +133,31 @@ def pair_contacts(g: RackPinionGeometry, mode: str) -> list[PairContact]:
     return out
 
 
-def continuous_drive(g: RackPinionGeometry, mode: str) -> ContinuousDrive:
+def continuous_drive(g: RackPinionGeometry, mode: str, pairs: tuple[PairContact, ...] | None = None
+                     ) -> ContinuousDrive:
     """Unbroken conjugate drive from angle 0 in ``mode``: the first hand-over gap, or the end of
-    the last pair's contact."""
-    pairs = tuple(p for p in pair_contacts(g, mode) if not p.empty)
+    the last pair's contact. ``pairs``: the contact intervals (default: the exact ones of
+    :func:`pair_contacts`; a mesh sweep passes the ones it measured)."""
+    pairs = tuple(p for p in (pair_contacts(g, mode) if pairs is None else pairs) if not p.empty)
     live = [p for p in pairs if p.start_rad <= 0.0 <= p.end_rad]
     if not live:
         return ContinuousDrive(mode, 0.0, f"{mode}: no tooth pair in contact at angle 0", None, pairs)
     cur = max(live, key=lambda p: p.end_rad)
+    handovers: list[tuple[float, float]] = []
     for p in sorted(pairs, key=lambda p: (p.start_rad, -p.j)):
         if p.end_rad <= cur.end_rad:
             continue
+        handovers.append((cur.end_rad, p.start_rad))
         if p.start_rad > cur.end_rad:
             a, b = math.degrees(cur.end_rad), math.degrees(p.start_rad)
             event = (f"{mode}: hand-over gap {pinion_name(g, cur.j)}→{pinion_name(g, p.j)} "
                      f"{a:.3f}°–{b:.3f}° ({pinion_name(g, cur.j)}'s contact ends {cur.end_by}, "
                      f"{pinion_name(g, p.j)}'s begins {p.start_by})")
-            return ContinuousDrive(mode, cur.end_rad, event, (cur.end_rad, p.start_rad), pairs)
+            return ContinuousDrive(mode, cur.end_rad, event, (cur.end_rad, p.start_rad), pairs, tuple(handovers))
         cur = p
     event = (f"{mode}: {pinion_name(g, cur.j)}'s conjugate contact ends at {math.degrees(cur.end_rad):.3f}° "
              f"({cur.end_by})")
-    return ContinuousDrive(mode, cur.end_rad, event, None, pairs)
+    return ContinuousDrive(mode, cur.end_rad, event, None, pairs, tuple(handovers))
 
 
 def whole_drive(g: RackPinionGeometry) -> tuple[ContinuousDrive, ContinuousDrive]:

@@ -101,6 +101,13 @@ def plot_svg(plot: Plot) -> str:
     ax.grid(True, alpha=0.3)
     if plot.series or hlines:
         ax.legend(fontsize=8, loc="best")
+    return figure_svg(fig)
+
+
+def figure_svg(fig) -> str:
+    """A matplotlib figure as inline SVG text (closes the figure; no timestamp metadata)."""
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     buf = io.StringIO()
     fig.savefig(buf, format="svg", metadata={"Date": None})

@@ -4,6 +4,12 @@
 see :mod:`.analysis` and docs/differential.md), and returns figures beside the paper's numbers.
 Paper values are attached only at the paper's own conditions (25 → −65 °C, 0.10 mm shim), so an
 override never shows a paper number beside a figure it does not describe.
+
+The paper's model is first order and linear in the temperature; beside it ``calc`` gives the
+exact-flank model (no mesh, :mod:`.temperature`) at the template's named temperatures and the
+tooth thinning the gears are built with (solved from a measured backlash when the template is
+calibrated, :mod:`.calibration`). The linear model's pass/fail figure is labelled as the linear
+model's; the verdict over the temperature ranges is the exact model's (``exact_range_verdict``).
 """
 
 from __future__ import annotations
@@ -14,9 +20,12 @@ from gearcheck.figures import Figure
 from gearcheck.mechanisms.differential import analysis
 from gearcheck.mechanisms.differential.analysis import analyse_params
 from gearcheck.mechanisms.differential.params import Params, shim_key
+from gearcheck.mechanisms.differential.temperature import STATE_TEXT, RangeCheck, range_check
 
-# Meshing tolerance when --tol is not given: the mesh-error bound must stay within 1/10 of the
-# least play checked (template: 2.98′ per side cold = 35.8 µm on d1/2, so ≤ 3.6 µm).
+# Meshing tolerance requested when --tol is not given. The pipeline refines it where the smallest
+# clearance decided (Differential.smallest_clearance, exact model) needs a pair bound ≤ 1/10 of it
+# and a practical mesh can give that; the template's (0.354′ overlap at −130 °C, 4.25 µm) cannot,
+# so its play verdicts rest on the exact model.
 MESH_TOL_MM = 0.003
 
 # The paper's printed values (report data only, never used in a computation).
@@ -143,6 +152,9 @@ def calc(params: Params) -> list[Figure]:
         ]
     cold_ok = design.cold_total_min_arcmin > 0.0
     warm_min, warm_max = design.warm_total_min_arcmin, design.warm_total_max_arcmin
+    exact = _exact_range(params)
+    linear = "paper's linear model"
+    exact_says = _exact_words(params, exact)
     figs += [
         # Designed backlash: tooth thinning (eq 10) + shim (eq 11), then cooled.
         Figure("unshimmed_warm_backlash_total_min_arcmin", "unshimmed warm total, least (thinning)",
@@ -162,17 +174,118 @@ def calc(params: Params) -> list[Figure]:
                design.cold_total_max_arcmin, "arcmin", digits=2),
         Figure("cold_backlash_per_side_min_arcmin", f"cold per side at {op.cold_C:g} °C, least",
                design.cold_total_min_arcmin / 2.0, "arcmin", digits=2),
-        Figure("cold_backlash_positive", "cold backlash stays > 0 (1 pass, 0 fail)", 1.0 if cold_ok else 0.0, "pass",
-               digits=0, note="PASS" if cold_ok else "FAIL: binds cold, thin the teeth or shim more"),
-        Figure("backlash_total_min_at_operating_min_arcmin", f"total at operating min {op.operating_min_C:g} °C, least",
-               r.total_backlash_at(op.operating_min_C, op.warm_C, warm_min), "arcmin", digits=2),
+        Figure("cold_backlash_positive", f"{linear}: cold total > 0 at {op.cold_C:g} °C (1 yes, 0 no)",
+               1.0 if cold_ok else 0.0, "pass", digits=0,
+               note=f"{linear}: {'free' if cold_ok else 'binds cold'}; exact geometry: {exact_says}"),
+        Figure("backlash_total_min_at_operating_min_arcmin",
+               f"{linear}: total at operating min {op.operating_min_C:g} °C, least",
+               r.total_backlash_at(op.operating_min_C, op.warm_C, warm_min), "arcmin", digits=2,
+               note=_exact_total(exact, "operating_min")),
         Figure("backlash_total_max_at_operating_max_arcmin",
-               f"total at operating max {op.operating_max_C:g} °C, largest",
+               f"{linear}: total at operating max {op.operating_max_C:g} °C, largest",
                r.total_backlash_at(op.operating_max_C, op.warm_C,
                                    warm_max), "arcmin", digits=2, note="loosest body pitch"),
-        Figure("backlash_total_min_at_storage_min_arcmin", f"total at storage min {op.storage_min_C:g} °C, least",
-               r.total_backlash_at(op.storage_min_C, op.warm_C, warm_min), "arcmin", digits=2),
-        Figure("backlash_total_max_at_storage_max_arcmin", f"total at storage max {op.storage_max_C:g} °C, largest",
+        Figure("backlash_total_min_at_storage_min_arcmin",
+               f"{linear}: total at storage min {op.storage_min_C:g} °C, least",
+               r.total_backlash_at(op.storage_min_C, op.warm_C, warm_min), "arcmin", digits=2,
+               note=_exact_total(exact, "storage_min")),
+        Figure("backlash_total_max_at_storage_max_arcmin",
+               f"{linear}: total at storage max {op.storage_max_C:g} °C, largest",
                r.total_backlash_at(op.storage_max_C, op.warm_C, warm_max), "arcmin", digits=2),
     ]
+    return figs + _thinning_figures(params) + _exact_figures(params, exact)
+
+
+# -- the exact model beside the paper's ----------------------------------------------------------
+
+def _exact_range(params: Params) -> RangeCheck | None:
+    """The exact model at the named temperatures, template shim (None: beyond its reach)."""
+    try:
+        return range_check(params, params.shim.thickness_mm, grid=False)
+    except (RuntimeError, ValueError):  # no contact within the exact model's reach (a huge play)
+        return None
+
+
+def _exact_words(params: Params, exact: RangeCheck | None) -> str:
+    """The exact geometry's finding over the ranges, in words."""
+    op = params.operating
+    if exact is None:
+        return "exact model out of its reach (no contact within 69′)"
+    if exact.binds_operating:
+        least, at = exact.operating
+        return f"binds in the operating range ({least:.2f}′ per side at {at:g} °C)"
+    if exact.binds_storage:
+        onset = exact.cold_onset_C if exact.cold_onset_C is not None else exact.hot_onset_C
+        where = f" below {onset:.1f} °C" if onset is not None and onset < op.warm_C else \
+            f" above {onset:.1f} °C" if onset is not None else ""
+        return f"binds in storage{where} ({exact.storage[0]:.2f}′ per side at {exact.storage[1]:g} °C)"
+    return "free over the operating and storage ranges"
+
+
+def _exact_total(exact: RangeCheck | None, name: str) -> str:
+    if exact is None:
+        return ""
+    total = 2.0 * exact.at(name)
+    return f"exact: {total:.2f}′{' (binds)' if total <= 0 else ''}"
+
+
+def _thinning_figures(params: Params) -> list[Figure]:
+    th = params.thinning()
+    um = analysis.UM_PER_MM
+    source = "solved on the exact geometry from the measured backlash" if th.calibrated else "template [backlash]"
+    figs = [
+        Figure("paper_model_thinning_min_um", "tooth thinning per mesh, least: paper-model reconstruction",
+               th.template_min_mm * um, "µm", digits=1, note="[backlash], through eqs (10), (11)"),
+        Figure("paper_model_thinning_max_um", "tooth thinning per mesh, largest: paper-model reconstruction",
+               th.template_max_mm * um, "µm", digits=1),
+        Figure("design_thinning_min_um", "tooth thinning per mesh, least: the gears built", th.min_mm * um, "µm",
+               digits=2, note=source),
+        Figure("design_thinning_max_um", "tooth thinning per mesh, largest: the gears built", th.max_mm * um, "µm",
+               digits=2),
+    ]
+    if th.calibrated:
+        c = params.calibration
+        where = f"shim {_mm(float(c.measured_shim_mm or 0.0))} mm, {c.measured_at_C:g} °C"
+        figs += [
+            Figure("exact_warm_backlash_total_min_at_measured_arcmin", f"exact warm total, least, {where}",
+                   th.exact_total_min_arcmin, "arcmin", digits=2,
+                   note=f"solved thinning; measured {c.measured_backlash_total_min_arcmin:g}′ (cycle minimum)"),
+            Figure("exact_warm_backlash_total_max_at_measured_arcmin", f"exact warm total, largest, {where}",
+                   th.exact_total_max_arcmin, "arcmin", digits=2,
+                   note=f"measured {c.measured_backlash_total_max_arcmin:g}′"),
+            Figure("exact_warm_backlash_total_min_at_paper_thinning_arcmin",
+                   f"exact warm total, least, {where}, paper-model thinning", th.template_exact_total_min_arcmin,
+                   "arcmin", digits=2, note="what the paper-model thinning builds: less than measured"),
+        ]
+    return figs
+
+
+def _exact_figures(params: Params, exact: RangeCheck | None) -> list[Figure]:
+    figs = [Figure("exact_model_solved", "exact-flank model solved at the named temperatures (1 yes, 0 no)",
+                   0.0 if exact is None else 1.0, "", digits=0,
+                   note="" if exact is not None else "no contact within the exact model's reach")]
+    if exact is None:
+        return figs
+    shim = params.shim.thickness_mm
+    for name in ("warm", "cold", "operating_min", "operating_max", "storage_min", "storage_max"):
+        figs.append(Figure(f"exact_play_per_side_min_arcmin_at_{name}",
+                           f"exact least play per side, {STATE_TEXT[name]} {exact.keys[name]:g} °C",
+                           exact.at(name), "arcmin", digits=3, note=f"shim {_mm(shim)} mm, exact flanks"))
+    (op_least, op_at), (st_least, st_at) = exact.operating, exact.storage
+    deep = exact.at("storage_min")
+    figs += [
+        Figure("exact_operating_least_play_arcmin", "exact least play per side over the operating range", op_least,
+               "arcmin", digits=3, note=f"at {op_at:g} °C"),
+        Figure("exact_storage_least_play_arcmin", "exact least play per side over the storage range", st_least,
+               "arcmin", digits=3, note=f"at {st_at:g} °C"),
+        Figure("exact_storage_min_overlap_um", "exact overlap at the storage minimum, on d1/2", exact.depth_um(deep),
+               "µm", digits=2, note="0: free" if deep > 0 else f"{-deep:.3f}′ per side"),
+    ]
+    onsets = [t for t in (exact.cold_onset_C, exact.hot_onset_C) if t is not None]
+    for key, t in zip(("exact_binding_onset_C", "exact_binding_onset_hot_C"), onsets, strict=False):
+        figs.append(Figure(key, "exact: contact starts at", t, "°C", digits=2, note="solved on the exact model"))
+    level = exact.level
+    figs.append(Figure("exact_range_verdict", "exact geometry over the ranges (1 pass, 0.5 warn, 0 fail)",
+                       {"pass": 1.0, "warn": 0.5, "fail": 0.0}[level], "pass", digits=1,
+                       note=f"{level.upper()}: {_exact_words(params, exact)}"))
     return figs

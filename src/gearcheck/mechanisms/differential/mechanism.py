@@ -1,6 +1,7 @@
 """The bevel-gear differential of the Zhurong Mars rover as a :class:`gearcheck.mechanism.Mechanism`:
 the paper's cold-backlash model (:func:`.calc`), the parts (:mod:`.assembly`, :mod:`.parts`), the
-warm/cold play sweep against the exact-flank model (:mod:`.sweep`, :mod:`.reduce`), the verdicts
+play sweep over temperature against the exact-flank model (:mod:`.sweep`, :mod:`.reduce`,
+:mod:`.temperature`), the thinning solved from a measured backlash (:mod:`.calibration`), the verdicts
 and the report (:mod:`.verdicts`, :mod:`.report`)."""
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from gearcheck.mechanisms.differential.params import Params as DifferentialParam
 if TYPE_CHECKING:
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
-    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body
 
 # The fuzz sweeps at reduced sampling: this many drive angles over the play period, its own shim.
@@ -38,6 +39,31 @@ class Differential(Mechanism):
         from gearcheck.mechanisms.differential.assembly import build_assembly
 
         return build_assembly(params)
+
+    def smallest_clearance(self, params: DifferentialParams) -> Clearance | None:
+        """The least play per side (exact flanks, cycle minimum) at the template's shim over the
+        meshed temperatures (warm, the cold design point, the operating range's ends, the storage
+        minimum) nearest zero but not zero — an overlap by its depth — as the arc it spans on
+        d1/2 (mm); the sweep decides a verdict on each of them."""
+        from gearcheck.mechanisms.differential.poses import gear_specs
+        from gearcheck.mechanisms.differential.temperature import clearance, meshed_plays, meshed_states
+
+        specs = gear_specs(params)
+        try:
+            plays = meshed_plays(params, specs=specs)
+        except RuntimeError:  # no contact within the exact model's reach: the sweep says so itself
+            return None
+        return clearance(specs, params.shim.thickness_mm, plays, dict(meshed_states(params)))
+
+    def study_row(self, params: DifferentialParams, level: str) -> dict[str, float]:
+        from gearcheck.mechanisms.differential import study
+
+        return study.exact_row(params) if level == "exact" else study.analytical_row(params)
+
+    def study_batch(self, params: DifferentialParams, columns: Mapping[str, Any]) -> dict[str, Any] | None:
+        from gearcheck.mechanisms.differential.study import paper_model
+
+        return paper_model(params, columns)
 
     def parts(self, assembly: Assembly) -> list[Part]:
         from gearcheck.mechanisms.differential.parts import build_parts

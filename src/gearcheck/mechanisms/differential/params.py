@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import math
 
-from pydantic import Field, model_validator
+from pydantic import Field, PrivateAttr, model_validator
 
 from gearcheck.mechanisms.differential import analysis, poses  # numpy only
-from gearcheck.params.common import ParamError, Section, bisect_boundary, fmt_bound, fmt_range
+from gearcheck.mechanisms.differential import calibration as cal  # numpy only
+from gearcheck.params.common import MISSING, ParamError, Section, bisect_boundary, fmt_bound, fmt_range
 
 # The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
 # d2/2, a/2 = l2 + d1/2). 0.05 mm is about 3′ of backlash per side (eq 11): within what the
@@ -205,6 +206,49 @@ class Shim(Section):
         return self
 
 
+CALIBRATION_KEYS = ("measured_backlash_total_min_arcmin", "measured_backlash_total_max_arcmin", "measured_shim_mm",
+                    "measured_at_C")
+MEASURED_TOTAL_MAX_ARCMIN = 120.0  # both sides; 60′ per side, well within the exact model's reach
+
+
+class Calibration(Section):
+    """Backlash measured on a built unit (optional; all four keys or none). When given, the tooth
+    thinning the gears are built with is solved on the exact geometry so that it reproduces the
+    measurement (the least measured total → the least thinning, read as the cycle minimum); the
+    [backlash] thinning stays as the paper-model reconstruction (docs/differential.md)."""
+
+    measured_backlash_total_min_arcmin: float | None = Field(
+        default=None, gt=0.0, le=MEASURED_TOTAL_MAX_ARCMIN,
+        description="least total backlash measured between the output shafts (both sides, two meshes)",
+        json_schema_extra=_unit("arcmin"))
+    measured_backlash_total_max_arcmin: float | None = Field(
+        default=None, gt=0.0, le=MEASURED_TOTAL_MAX_ARCMIN,
+        description="largest total backlash measured between the output shafts (both sides)",
+        json_schema_extra=_unit("arcmin"))
+    measured_shim_mm: float | None = Field(default=None, ge=0.0, le=1.0,
+                                           description="shim under each big gear when it was measured",
+                                           json_schema_extra=_unit("mm"))
+    measured_at_C: float | None = Field(default=None, ge=-150, le=150, description="temperature of the measurement",
+                                        json_schema_extra=_unit("°C"))
+
+    @model_validator(mode="after")
+    def _all_or_none(self) -> Calibration:
+        given = [k for k in CALIBRATION_KEYS if getattr(self, k) is not None]
+        if given and len(given) < len(CALIBRATION_KEYS):
+            missing = next(k for k in CALIBRATION_KEYS if getattr(self, k) is None)
+            raise ParamError(f"calibration.{missing}", MISSING,
+                             f"allowed: a value — [calibration] needs all of {', '.join(CALIBRATION_KEYS)} or none")
+        lo, hi = self.measured_backlash_total_min_arcmin, self.measured_backlash_total_max_arcmin
+        if lo is not None and hi is not None and hi < lo:
+            raise ParamError("calibration.measured_backlash_total_max_arcmin", hi,
+                             f"allowed >= measured_backlash_total_min_arcmin = {lo}′")
+        return self
+
+    @property
+    def given(self) -> bool:
+        return self.measured_backlash_total_min_arcmin is not None
+
+
 class Params(Section):
     """The whole template (less its top-level ``mechanism`` key)."""
 
@@ -214,6 +258,17 @@ class Params(Section):
     dimensions: Dimensions
     operating: Operating
     shim: Shim
+    calibration: Calibration = Field(default_factory=Calibration)
+    # the thinning solved from [calibration] by the validation (None: the template's [backlash])
+    _thinning: cal.Thinning | None = PrivateAttr(default=None)
+
+    def design_thinning(self) -> cal.Thinning | None:
+        """The tooth thinning solved from [calibration] (None when not calibrated)."""
+        return self._thinning
+
+    def thinning(self) -> cal.Thinning:
+        """The thinning the gears are built with and where it comes from."""
+        return self._thinning if self._thinning is not None else cal.template_thinning(self)
 
     @model_validator(mode="after")
     def _assembly(self) -> Params:
@@ -241,7 +296,32 @@ class Params(Section):
         why = _cad_blocker(self)
         if why is not None:
             raise _blame(self, why)
+        if self.calibration.given:
+            self._thinning = _calibrate(self)
         return self
+
+
+def _calibrate(params: Params) -> cal.Thinning:
+    """The thinning solved from the measured backlash; a measurement the exact geometry cannot
+    reproduce is rejected on that measured value, with the limit where there is one."""
+    c = params.calibration
+    try:
+        solved = cal.calibrated_thinning(params)
+    except cal.CalibrationError as exc:
+        key = f"measured_backlash_total_{exc.which}_arcmin"
+        if exc.bound is None:
+            allowed = "allowed: a backlash the exact geometry can reproduce"
+        else:
+            allowed = f"allowed {'>=' if exc.side == 'lower' else '<='} {fmt_bound(exc.bound, exc.side)}′"
+        raise ParamError(f"calibration.{key}", getattr(c, key), f"{allowed}: {exc.why}") from None
+    params._thinning = solved
+    why = _cad_blocker(params)
+    if why is not None:
+        params._thinning = None
+        raise ParamError("calibration.measured_backlash_total_min_arcmin", c.measured_backlash_total_min_arcmin,
+                         f"allowed: a backlash whose solved tooth thinning ({solved.min_mm:.4f} mm) the CAD can "
+                         f"build ({why})")
+    return solved
 
 
 # -- the CAD's own gear specs ----------------------------------------------------------------

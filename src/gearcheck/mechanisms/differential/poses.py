@@ -50,12 +50,21 @@ class GearSpecs:
     small: BevelGearSpec
 
 
-def gear_specs(params) -> GearSpecs:
+def design_thinning_min_mm(params) -> float:
+    """The least tooth thinning of one mesh the gears are built with: solved from a measured
+    backlash when the template is calibrated (:mod:`.calibration`, stored by the validation),
+    else the template's ``backlash.mesh_thinning_min_mm``."""
+    solved = params.design_thinning() if hasattr(params, "design_thinning") else None
+    return solved.min_mm if solved is not None else params.backlash.mesh_thinning_min_mm
+
+
+def gear_specs(params, thinning_mm: float | None = None) -> GearSpecs:
     """The two gear designs from the template: long/short addendum (+x on the small gear, −x on
-    the big one) and the designed mesh thinning (the template's least value: the tightest mesh,
-    the one that binds first when cold) split equally between the two gears."""
+    the big one) and the mesh thinning split equally between the two gears — the designed least
+    (the tightest mesh, the one that binds first when cold, :func:`design_thinning_min_mm`) unless
+    ``thinning_mm`` is given."""
     g = params.gears
-    thinning = params.backlash.mesh_thinning_min_mm / 2.0
+    thinning = (design_thinning_min_mm(params) if thinning_mm is None else thinning_mm) / 2.0
     d = params.dimensions
     small = BevelGearSpec(
         teeth=g.small_teeth, mate_teeth=g.big_teeth, module_mm=g.module_mm,

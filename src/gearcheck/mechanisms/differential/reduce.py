@@ -1,7 +1,8 @@
 """The differential's sweep results reduced (in the parent process): contact turns per pose into
 plays per output shaft, cycle minima per shim and state, the paper's model beside them, the
-deviations of the mesh from the exact flanks, the worst pose to confirm on the exact B-rep, the
-least play decided on (for the mesh-resolution rule) and the speed figures."""
+deviations of the mesh from the exact flanks, the exact model over the temperature ranges (with
+the onset of binding solved), the worst pose to confirm on the exact B-rep, the least play
+decided on (for the mesh-resolution rule) and the speed figures."""
 
 from __future__ import annotations
 
@@ -14,28 +15,38 @@ import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel_mesh import drive_poses
-from gearcheck.mechanisms.differential.analysis import PerSide, model_per_side
+from gearcheck.mechanisms.differential.analysis import PerSide, analyse_params, model_per_side
+from gearcheck.mechanisms.differential.params import shim_key
 from gearcheck.mechanisms.differential.poses import GearSpecs
-from gearcheck.mechanisms.differential.sweep import DIRECTIONS, STATES, SweepSetup
+from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup
+from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, clearance,
+                                                           merge_plays, range_check)
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
 from gearcheck.results import Clearance, SweepOutcome, WorstPose
 from gearcheck.sweep.engine import Scene
 
 # Mesh vs exact: within the mesh-error bound (as an angle on d1/2) plus this fraction.
 AGREEMENT_RELATIVE = 0.02
-W, C = STATES.index("warm"), STATES.index("cold")
+# The states whose least play decides a fail (the storage minimum only warns): the worst pose to
+# confirm on the exact B-rep is the least play among them.
+FAIL_STATES = ("warm", "cold", "operating_min", "operating_max")
 
 
 @dataclass(frozen=True)
 class SweepData:
     """The reduced sweep, for the verdicts and the report. Arrays indexed (shim, state, drive
-    angle, big gear), arcmin; ``*_min`` the cycle minima (shim, state)."""
+    angle, big gear), arcmin, NaN where a state was not measured at a shim (the extra states are
+    measured at the template's shim only); ``*_min`` the cycle minima (shim, state). ``ranges``:
+    the exact model over the temperature grid, per shim index (the template's at least)."""
 
     specs: GearSpecs
     shims: list[float]
     template_shim_mm: float
     t: int  # index of the template's shim
     z: int | None  # index of shim 0, if swept
+    states: list[tuple[str, float]]  # (name, °C)
+    index: dict[str, int]  # state name → index (a name sharing another's temperature shares its index)
+    measured: np.ndarray  # (shim, state) bool
     angles: np.ndarray
     period_rad: float
     geom_plus: np.ndarray
@@ -44,6 +55,8 @@ class SweepData:
     exact_minus: np.ndarray
     centred_free: np.ndarray
     models: list[PerSide]
+    model_per_K: float  # the paper's linear model: play per side lost per kelvin of cooling
+    warm_C: float
     contact_dev: np.ndarray  # |geometry − exact| per contact
     contact_ok: bool
     total_ok: bool
@@ -52,6 +65,15 @@ class SweepData:
     bound_arcmin: float
     exact_solves: int
     exact_reused: int
+    ranges: dict[int, RangeCheck]
+
+    @property
+    def w(self) -> int:
+        return self.index["warm"]
+
+    @property
+    def c(self) -> int:
+        return self.index["cold"]
 
     @property
     def geom_play(self) -> np.ndarray:
@@ -61,54 +83,89 @@ class SweepData:
     def exact_play(self) -> np.ndarray:
         return self.exact_plus - self.exact_minus
 
+    def _cycle_min(self, play: np.ndarray) -> np.ndarray:
+        least = np.min(np.where(self.measured[:, :, None, None], play, np.inf), axis=(2, 3))
+        return np.where(self.measured, least, np.nan)
+
     @property
     def geom_min(self) -> np.ndarray:
-        return self.geom_play.min(axis=(2, 3))
+        return self._cycle_min(self.geom_play)
 
     @property
     def exact_min(self) -> np.ndarray:
-        return self.exact_play.min(axis=(2, 3))
+        return self._cycle_min(self.exact_play)
 
     @property
     def total_dev(self) -> np.ndarray:
-        """|geometry − exact| per play."""
+        """|geometry − exact| per play (NaN where not measured)."""
         return np.abs(self.geom_play - self.exact_play)
 
     @property
     def model(self) -> PerSide:
         return self.models[self.t]
 
+    @property
+    def range(self) -> RangeCheck:
+        """The exact range at the template's shim."""
+        return self.ranges[self.t]
+
+    def model_play(self, i: int, temperature_C: float) -> float:
+        """The paper's linear model (eqs 1–11) per side at shim i and any temperature."""
+        return self.models[i].warm - self.model_per_K * (self.warm_C - temperature_C)
+
+    def state_label(self, j: int) -> str:
+        name, temp = self.states[j]
+        return f"{STATE_TEXT[name]} {temp:g} °C"
+
 
 def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
+    range_index = {task for _, task in setup.range_tasks}
+    mesh_results = [r for n, r in enumerate(results) if n not in range_index]
     by_key = {}
-    for result, keys in zip(results, setup.owners, strict=True):
+    for result, keys in zip(mesh_results, setup.owners, strict=True):
         for key, mesh in zip(keys, result["mesh"], strict=True):
-            by_key[key] = {**mesh, "exact_rad": result["exact_rad"], "exact_s": result["exact_s"] / len(keys)}
+            by_key[key] = {**mesh, "exact_rad": result["exact_rad"]}
+    t0 = time.perf_counter()
+    ranges = _ranges(setup, results)
+    onset_s = time.perf_counter() - t0
     wall_s = time.perf_counter() - setup.started
-    data = _arrays(setup, by_key, len(results))
+    data = _arrays(setup, by_key, ranges)
     summary = _summary(setup, data, by_key)
     worst = _worst_poses(setup, data, by_key)
     t = data.t
-    clearance = smallest_clearance(data.specs, data.shims[t], data.exact_min[t, W], data.exact_min[t, C])
-    return SweepOutcome(summary, worst, clearance, _timings(by_key, results, wall_s), data)
+    outcome_clearance = smallest_clearance(data.specs, data.shims[t], data.exact_min[t], data.states)
+    range_s = sum(results[task]["exact_s"] for _, task in setup.range_tasks)
+    return SweepOutcome(summary, worst, outcome_clearance, _timings(setup, by_key, wall_s, range_s, onset_s), data)
 
 
-def _arrays(setup: SweepSetup, by_key: dict, solves: int) -> SweepData:
+def _ranges(setup: SweepSetup, results: list[dict]) -> dict[int, RangeCheck]:
+    """The exact range per shim from its chunks, with the onset of binding solved."""
+    chunks: dict[int, list] = {}
+    for i, task in setup.range_tasks:
+        chunks.setdefault(i, []).append(results[task]["plays"])
+    return {i: range_check(setup.params, setup.shims[i], specs=setup.layout.specs, plays=merge_plays(parts))
+            for i, parts in chunks.items()}
+
+
+def _arrays(setup: SweepSetup, by_key: dict, ranges: dict[int, RangeCheck]) -> SweepData:
     arcmin = bp.ARCMIN_PER_RAD
-    shims, angles = setup.shims, setup.angles
-    shape = (len(shims), len(STATES), len(angles), len(BIG_GEARS))
-    geom_plus, geom_minus = np.empty(shape), np.empty(shape)
-    exact_plus, exact_minus = np.empty(shape), np.empty(shape)
+    shims, angles, names = setup.shims, setup.angles, [n for n, _ in setup.states]
+    shape = (len(shims), len(names), len(angles), len(BIG_GEARS))
+    geom_plus, geom_minus = np.full(shape, np.nan), np.full(shape, np.nan)
+    exact_plus, exact_minus = np.full(shape, np.nan), np.full(shape, np.nan)
     centred_free = np.ones(shape, dtype=bool)
+    measured = np.zeros(shape[:2], dtype=bool)
     deviation = []  # per contact: (|geom − exact|, allowed)
     for (i, state, k, big, _small, _d), r in by_key.items():
-        j, b = STATES.index(state), BIG_GEARS.index(big)
+        j, b = names.index(state), BIG_GEARS.index(big)
+        measured[i, j] = True
         geom = 0.5 * (r["free_rad"] + r["touching_rad"]) * arcmin
         exact = r["exact_rad"] * arcmin
         deviation.append((abs(geom - exact), setup.bound_arcmin + AGREEMENT_RELATIVE * abs(exact)))
         centred_free[i, j, k, b] &= not r["centred_collides"]
     for i in range(len(shims)):
-        for j, state in enumerate(STATES):
+        for j in setup.shim_states[i]:
+            state = names[j]
             for k in range(len(angles)):
                 for b, big in enumerate(BIG_GEARS):
                     rs = [(by_key[(i, state, k, big, s, 1)], by_key[(i, state, k, big, s, -1)]) for s in SMALL_GEARS]
@@ -118,44 +175,88 @@ def _arrays(setup: SweepSetup, by_key: dict, solves: int) -> SweepData:
                     exact_minus[i, j, k, b] = max(m["exact_rad"] for _, m in rs) * arcmin
     geom_play = geom_plus - geom_minus
     exact_play = exact_plus - exact_minus
-    total_dev = np.abs(geom_play - exact_play)
-    total_ok = bool(np.all(total_dev <= 2.0 * setup.bound_arcmin + AGREEMENT_RELATIVE * np.abs(exact_play)))
+    m4 = measured[:, :, None, None] & np.ones(shape, dtype=bool)
+    total_dev = np.abs(geom_play - exact_play)[m4]
+    total_ok = bool(np.all(total_dev <= 2.0 * setup.bound_arcmin + AGREEMENT_RELATIVE * np.abs(exact_play[m4])))
     template_shim = setup.layout.template_shim_mm
+    params = setup.params
+    index = {name: names.index(name) for name in names}
+    for name, temp in (("warm", params.operating.warm_C), ("cold", params.operating.cold_C)):
+        index.setdefault(name, int(np.argmin([abs(temp - tt) for _, tt in setup.states])))
     return SweepData(
         specs=setup.layout.specs, shims=shims, template_shim_mm=template_shim,
         t=shims.index(round(template_shim, 9)), z=shims.index(0.0) if 0.0 in shims else None,
+        states=list(setup.states), index=index, measured=measured,
         angles=angles, period_rad=setup.period_rad, geom_plus=geom_plus, geom_minus=geom_minus,
         exact_plus=exact_plus, exact_minus=exact_minus, centred_free=centred_free,
-        models=[model_per_side(setup.params, s) for s in shims],
+        models=[model_per_side(params, s) for s in shims],
+        model_per_K=analyse_params(params).drop_per_side_per_K_arcmin, warm_C=params.operating.warm_C,
         contact_dev=np.array([dv for dv, _ in deviation]),
         contact_ok=all(dv <= allowed for dv, allowed in deviation), total_ok=total_ok, contacts=len(by_key),
-        bound_mm=setup.bound_mm, bound_arcmin=setup.bound_arcmin, exact_solves=solves,
-        exact_reused=setup.exact_reused)
+        bound_mm=setup.bound_mm, bound_arcmin=setup.bound_arcmin, exact_solves=setup.exact_solves,
+        exact_reused=setup.exact_reused, ranges=ranges)
+
+
+def _range_summary(data: SweepData, r: RangeCheck, i: int) -> dict:
+    """The exact model over the temperature ranges at shim i, as plain numbers."""
+    op, st = r.operating, r.storage
+    out: dict[str, Any] = {
+        "grid_step_max_K": GRID_STEP_K,
+        "temperatures_C": r.temperatures_C.tolist(),
+        "exact_least_play_per_side_arcmin": r.least_arcmin.tolist(),
+        "model_play_per_side_arcmin": [data.model_play(i, float(tc)) for tc in r.temperatures_C],
+        "operating_least_play_arcmin": op[0],
+        "operating_least_play_at_C": op[1],
+        "storage_least_play_arcmin": st[0],
+        "storage_least_play_at_C": st[1],
+        "binds_in_operating_range": int(r.binds_operating),
+        "binds_in_storage_range": int(r.binds_storage),
+        "storage_min_play_arcmin": r.at("storage_min"),
+        "storage_min_overlap_um": r.depth_um(r.at("storage_min")),
+        "storage_max_play_arcmin": r.at("storage_max"),
+    }
+    for name in ("warm", "cold", "operating_min", "operating_max"):
+        out[f"{name}_play_arcmin"] = r.at(name)
+    if r.cold_onset_C is not None:
+        out["binding_onset_C"] = r.cold_onset_C
+    if r.hot_onset_C is not None:
+        out["binding_onset_hot_C"] = r.hot_onset_C
+    if r.plays is not None and r.plays.spots is not None:
+        spots = r.plays.spots  # (T, plus/minus, big/small)
+        out["contact"] = {
+            "big_along_toe_to_heel_plus": [s[0][0].along for s in spots],
+            "big_height_root_to_tip_plus": [s[0][0].height for s in spots],
+            "small_height_root_to_tip_plus": [s[0][1].height for s in spots],
+            "big_along_toe_to_heel_minus": [s[1][0].along for s in spots],
+            "big_height_root_to_tip_minus": [s[1][0].height for s in spots],
+            "small_height_root_to_tip_minus": [s[1][1].height for s in spots],
+        }
+    return out
 
 
 def _summary(setup: SweepSetup, data: SweepData, by_key: dict) -> dict:
-    t, z = data.t, data.z
+    t, z, w, c = data.t, data.z, data.w, data.c
     geom_min, exact_min, models, model = data.geom_min, data.exact_min, data.models, data.model
     summary: dict[str, Any] = {
         "template_shim_mm": data.template_shim_mm,
-        "geom_cold_drop_per_side_arcmin": float(geom_min[t, W] - geom_min[t, C]),
-        "exact_cold_drop_per_side_arcmin": float(exact_min[t, W] - exact_min[t, C]),
+        "geom_cold_drop_per_side_arcmin": float(geom_min[t, w] - geom_min[t, c]),
+        "exact_cold_drop_per_side_arcmin": float(exact_min[t, w] - exact_min[t, c]),
         "model_cold_drop_per_side_arcmin": model.drop,
         "clean_model_cold_drop_per_side_arcmin": model.clean_drop,
-        "geom_warm_play_min_arcmin": float(geom_min[t, W]),
-        "geom_cold_play_min_arcmin": float(geom_min[t, C]),
-        "exact_warm_play_min_arcmin": float(exact_min[t, W]),
-        "exact_cold_play_min_arcmin": float(exact_min[t, C]),
+        "geom_warm_play_min_arcmin": float(geom_min[t, w]),
+        "geom_cold_play_min_arcmin": float(geom_min[t, c]),
+        "exact_warm_play_min_arcmin": float(exact_min[t, w]),
+        "exact_cold_play_min_arcmin": float(exact_min[t, c]),
         "model_warm_play_min_arcmin": model.warm,
         "model_cold_play_min_arcmin": model.cold,
-        "geom_cold_backlash_total_min_arcmin": float(2.0 * geom_min[t, C]),
-        "exact_cold_backlash_total_min_arcmin": float(2.0 * exact_min[t, C]),
-        "geom_warm_backlash_total_min_arcmin": float(2.0 * geom_min[t, W]),
-        "exact_warm_backlash_total_min_arcmin": float(2.0 * exact_min[t, W]),
+        "geom_cold_backlash_total_min_arcmin": float(2.0 * geom_min[t, c]),
+        "exact_cold_backlash_total_min_arcmin": float(2.0 * exact_min[t, c]),
+        "geom_warm_backlash_total_min_arcmin": float(2.0 * geom_min[t, w]),
+        "exact_warm_backlash_total_min_arcmin": float(2.0 * exact_min[t, w]),
         "mesh_error_bound_mm": data.bound_mm,
         "mesh_error_bound_arcmin": data.bound_arcmin,
         "max_mesh_exact_contact_deviation_arcmin": float(data.contact_dev.max()),
-        "max_mesh_exact_play_deviation_arcmin": float(data.total_dev.max()),
+        "max_mesh_exact_play_deviation_arcmin": float(np.nanmax(data.total_dev)),
         "angles_per_cycle": len(data.angles),
         "poses": int(sum(r["calls"] for r in by_key.values())),
         "exact_solves": data.exact_solves,
@@ -165,43 +266,57 @@ def _summary(setup: SweepSetup, data: SweepData, by_key: dict) -> dict:
         "pruned_meshes": setup.pruned_meshes,
         "pruned_triangles_mean": setup.pruned_triangles_mean,
     }
+    summary["states"] = {
+        name: {"temperature_C": temp, "geom_play_min_arcmin": float(geom_min[t, j]),
+               "exact_play_min_arcmin": float(exact_min[t, j]), "model_play_min_arcmin": data.model_play(t, temp),
+               "max_mesh_exact_play_deviation_arcmin": float(np.nanmax(data.total_dev[t, j]))}
+        for j, (name, temp) in enumerate(data.states)}
     if z is not None:
-        summary["geom_shim_gain_per_side_arcmin"] = float(geom_min[t, W] - geom_min[z, W])
-        summary["exact_shim_gain_per_side_arcmin"] = float(exact_min[t, W] - exact_min[z, W])
+        summary["geom_shim_gain_per_side_arcmin"] = float(geom_min[t, w] - geom_min[z, w])
+        summary["exact_shim_gain_per_side_arcmin"] = float(exact_min[t, w] - exact_min[z, w])
         summary["model_shim_gain_per_side_arcmin"] = model.warm - models[z].warm
     summary["shim_study"] = {
         "shims_mm": list(data.shims),
-        "geom_warm_play_min_arcmin": geom_min[:, W].tolist(),
-        "geom_cold_play_min_arcmin": geom_min[:, C].tolist(),
-        "exact_warm_play_min_arcmin": exact_min[:, W].tolist(),
-        "exact_cold_play_min_arcmin": exact_min[:, C].tolist(),
+        "geom_warm_play_min_arcmin": geom_min[:, w].tolist(),
+        "geom_cold_play_min_arcmin": geom_min[:, c].tolist(),
+        "exact_warm_play_min_arcmin": exact_min[:, w].tolist(),
+        "exact_cold_play_min_arcmin": exact_min[:, c].tolist(),
         "model_warm_play_min_arcmin": [m.warm for m in models],
         "model_cold_play_min_arcmin": [m.cold for m in models],
         "clean_model_warm_play_min_arcmin": [m.clean_warm for m in models],
         "clean_model_cold_play_min_arcmin": [m.clean_cold for m in models],
-        "geom_cold_drop_per_side_arcmin": (geom_min[:, W] - geom_min[:, C]).tolist(),
-        "exact_cold_drop_per_side_arcmin": (exact_min[:, W] - exact_min[:, C]).tolist(),
+        "geom_cold_drop_per_side_arcmin": (geom_min[:, w] - geom_min[:, c]).tolist(),
+        "exact_cold_drop_per_side_arcmin": (exact_min[:, w] - exact_min[:, c]).tolist(),
         "model_cold_drop_per_side_arcmin": [m.drop for m in models],
     }
+    summary["exact_range"] = _range_summary(data, data.range, t)
+    others = sorted(i for i in data.ranges if i != t)
+    if others:
+        summary["exact_range_by_shim"] = {f"shim_{shim_key(data.shims[i])}mm": _range_summary(
+            data, data.ranges[i], i) for i in others}
     return summary
 
 
 def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[WorstPose]:
-    """The cold pose with the least play at the template's shim (the side with the smaller margin):
-    the big gear at the free side of its contact bracket, and at the centred pose; mesh distances
-    on the whole (unpruned) cold meshes."""
+    """The pose with the least play at the template's shim among the states that decide a fail
+    (warm, the cold design point, the operating range's ends), on the side with the smaller
+    margin: the big gear at the free side of its contact bracket, and at the centred pose; mesh
+    distances on the whole (unpruned) meshes in that state."""
     t = data.t
     geom_play = data.geom_play
-    kk, bb = np.unravel_index(np.argmin(geom_play[t, C]), geom_play[t, C].shape)
+    cands = sorted({data.index[n] for n in FAIL_STATES if n in data.index})
+    j = min(cands, key=lambda jj: float(np.min(geom_play[t, jj])))
+    state = data.states[j][0]
+    kk, bb = np.unravel_index(np.argmin(geom_play[t, j]), geom_play[t, j].shape)
     big = BIG_GEARS[bb]
-    plus_margin, minus_margin = data.geom_plus[t, C, kk, bb], -data.geom_minus[t, C, kk, bb]
+    plus_margin, minus_margin = data.geom_plus[t, j, kk, bb], -data.geom_minus[t, j, kk, bb]
     d = 1 if plus_margin <= minus_margin else -1
-    cands = [(s, by_key[(t, "cold", kk, big, s, d)]) for s in SMALL_GEARS]
-    small, rec = (min if d == 1 else max)(cands, key=lambda c: c[1]["free_rad"])
+    pairs = [(s, by_key[(t, state, kk, big, s, d)]) for s in SMALL_GEARS]
+    small, rec = (min if d == 1 else max)(pairs, key=lambda p: p[1]["free_rad"])
 
     layout, bodies = setup.layout, setup.bodies
     shim, phi = data.shims[t], data.angles[kk]
-    thermal = setup.thermal_at[shim]
+    thermal = setup.thermal_at[(shim, state)]
     built = {n: bodies[n].pose for n in layout.big_gears + layout.small_gears}
     poses = drive_poses(built, layout.big_gears, layout.small_gears, layout.specs.big, layout.specs.small, phi,
                         shim - layout.template_shim_mm)
@@ -211,8 +326,9 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
     scene.set_pose(small, ts.cold_pose(poses[small]))
     out = []
     way = "+" if d > 0 else "−"
-    for label, turn in ((f"cold least play, contact {way} (free side), {math.degrees(phi):.2f}°", rec["free_rad"]),
-                        (f"cold least play, centred, {math.degrees(phi):.2f}°", 0.0)):
+    text = "cold" if state == "cold" else STATE_TEXT[state]
+    for label, turn in ((f"{text} least play, contact {way} (free side), {math.degrees(phi):.2f}°", rec["free_rad"]),
+                        (f"{text} least play, centred, {math.degrees(phi):.2f}°", 0.0)):
         big_pose = poses[big] @ bp.rot_z4(turn)
         scene.set_pose(big, tb.cold_pose(big_pose))
         distance = scene.distance(big, small).distance
@@ -221,26 +337,22 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
     return out
 
 
-def smallest_clearance(specs: GearSpecs, shim_mm: float, warm_arcmin: float, cold_arcmin: float) -> Clearance | None:
-    """The least positive play per side at the template's shim (exact flanks, warm or cold) as the
-    arc it spans on the big gear's outer pitch circle: the radius the check converts its mesh
-    bound with, so the rule reads bound ≤ play/10 in the verdicts' own terms."""
-    plays = [(v, state) for v, state in ((cold_arcmin, "cold"), (warm_arcmin, "warm")) if v > 0.0]
-    if not plays:
-        return None
-    play, state = min(plays)
-    d1_half = specs.big.outer_pitch_diameter_mm / 2.0
-    return Clearance(float(play) / bp.ARCMIN_PER_RAD * d1_half,
-                     f"least {state} play per side at shim {shim_mm:.2f} mm (exact flanks, {play:.3f}′ on d1/2)")
+def smallest_clearance(specs: GearSpecs, shim_mm: float, plays_arcmin, states: list[tuple[str, float]]
+                       ) -> Clearance | None:
+    """The least play per side (exact flanks) nearest zero but not zero at the template's shim over
+    the meshed states — an overlap counts by its depth — as the arc it spans on d1/2: the same
+    rule as :meth:`.mechanism.Differential.smallest_clearance`, on the sweep's own exact solves."""
+    plays = {name: float(v) for (name, _), v in zip(states, plays_arcmin, strict=True) if math.isfinite(v)}
+    return clearance(specs, shim_mm, plays, dict(states))
 
 
-def _timings(by_key: dict, results: list, wall_s: float) -> dict:
+def _timings(setup: SweepSetup, by_key: dict, wall_s: float, range_s: float, onset_s: float) -> dict:
     """Speed of the sweep: collide calls per second (over the time spent bisecting, per worker,
     and over the wall time of the whole sweep), one play measurement (one big gear against one
-    small gear, both ways, on the meshes), one exact contact solve, wall time of the sweep."""
+    small gear, both ways, on the meshes), one exact contact solve (the vectorised batch), the
+    exact range (worker time) and its onset solves, wall time of the sweep."""
     calls = sum(r["calls"] for r in by_key.values())
     mesh_s = sum(r["mesh_s"] for r in by_key.values())
-    exact_s = sum(r["exact_s"] for r in results)
     pair_play_s = [by_key[key]["mesh_s"] + by_key[key[:5] + (-1,)]["mesh_s"] for key in by_key if key[5] == 1]
     return {
         "collide_calls": int(calls),
@@ -248,6 +360,9 @@ def _timings(by_key: dict, results: list, wall_s: float) -> dict:
         "poses_per_s": calls / wall_s,
         "ms_per_play_measurement": 1e3 * float(np.mean(pair_play_s)),
         "ms_per_play_measurement_max": 1e3 * float(np.max(pair_play_s)),
-        "ms_per_exact_contact": 1e3 * exact_s / len(results),
+        "ms_per_exact_contact": 1e3 * setup.exact_s / max(setup.exact_solves, 1),
+        "exact_contacts_s": setup.exact_s,
+        "exact_range_worker_s": range_s,
+        "exact_onset_s": onset_s,
         "sweep_wall_s": wall_s,
     }

@@ -1,12 +1,19 @@
 """Random differential templates for the fuzz and the property tests (stdlib only): every
 documented knob redrawn around the shipped template, mostly inside the band where a design can
-work, sometimes outside it (see :mod:`gearcheck.mechanisms.sampling`)."""
+work, sometimes outside it (see :mod:`gearcheck.mechanisms.sampling`). The optional measured
+backlash ([calibration]) is kept on a few sets only (:data:`CALIBRATED`), redrawn around what the
+paper's first-order model says the drawn design has: a calibrated set solves its thinning on the
+exact geometry, and the thinning knobs would otherwise go unexercised."""
 
 from __future__ import annotations
 
 import math
 
 from gearcheck.mechanisms.sampling import OUT_OF_BAND, Draw, _int_knob, _knob, _near
+
+# Share of sets that keep a [calibration] (a measured backlash to solve the thinning from).
+CALIBRATED = 0.15
+ARCMIN_PER_RAD = 10800.0 / math.pi
 
 
 def sample_differential(data: dict, draw: Draw) -> None:
@@ -52,3 +59,24 @@ def sample_differential(data: dict, draw: Draw) -> None:
     s = data["shim"]
     s["thickness_mm"] = _knob(draw, 0.0, 0.5, 3)
     s["study_mm"] = [round(_knob(draw, 0.0, 0.5, 2), 2) for _ in range(draw.integer(0, 5))]
+
+    if "calibration" in data and not draw.chance(CALIBRATED):
+        del data["calibration"]
+    elif "calibration" in data:
+        _calibration(data, draw)
+
+
+def _calibration(data: dict, draw: Draw) -> None:
+    """A measured warm total around the first-order estimate for the drawn design: the thinning
+    on d1/2 plus eq (11)'s shim gain with the pitch cone angle only (both sides)."""
+    g, b, c = data["gears"], data["backlash"], data["calibration"]
+    m, z1, z2 = g["module_mm"], g["big_teeth"], g["small_teeth"]
+    shim = _knob(draw, 0.0, 0.3, 3)
+    d1_half = max(m * z1 / 2.0, 1e-3)
+    delta1 = math.atan2(z1, z2) if z2 else 0.0
+    gain = 2.0 * math.tan(math.radians(20.0)) * shim * math.sin(delta1)
+    total = 2.0 * (b["mesh_thinning_min_mm"] + gain) / d1_half * ARCMIN_PER_RAD
+    c["measured_shim_mm"] = shim
+    c["measured_at_C"] = _knob(draw, 15.0, 30.0, 1)
+    c["measured_backlash_total_min_arcmin"] = round(total * _knob(draw, 0.7, 1.3, 3), 3)
+    c["measured_backlash_total_max_arcmin"] = round(c["measured_backlash_total_min_arcmin"] + _knob(draw, 0.0, 3.0), 3)

@@ -1,12 +1,17 @@
-"""The differential's sweep plan: angular play of the output shafts, warm and cold, for each
-study shim — measured with FCL on the built meshes and checked against the exact-flank model.
+"""The differential's sweep plan: angular play of the output shafts at several temperatures —
+warm and the cold design point for each study shim, and at the template's shim also the ends of
+the operating range and the storage minimum — measured with FCL on the built meshes and checked
+against the exact-flank model; and the exact model alone over the whole operating and storage
+ranges (:mod:`.temperature`), as tasks of the same plan.
 
 Poses are data. At drive angle φ each small gear turns φ about its own axis and each big gear
 −φ·z_small/z_big about its own (the pitch cones roll; carrier held), from the poses the build
 placed them at (:func:`gearcheck.geometry.bevel_mesh.drive_poses`). Other shims than the built
 one translate the big gears along their own axes by the shim difference; nothing else about the
-geometry changes. The cold state moves and shrinks every gear by its own materials about its own
-datum (:mod:`.thermal`), never a uniform scale of the assembly.
+geometry changes. A state at temperature T moves and shrinks (or grows) every gear by its own
+materials about its own datum (:mod:`.thermal`, from warm to T), never a uniform scale of the
+assembly. The extra states only at the template's shim: all shims × all states would triple the
+mesh work for figures the exact model gives anyway.
 
 Play of one output shaft: hold the small gears, turn the big gear about its own axis until a
 flank touches, both ways (bisection on ``collide``, :func:`gearcheck.sweep.engine.bisect_contact`,
@@ -37,15 +42,22 @@ first contact (face or edge) lies in it; and because the other direction's flank
 mesh, each direction's contact is measured even where the other side already binds (cold, shim
 0), which gives a negative play instead of a failed bisection.
 
-Exact model: for the same poses and scales, :func:`gearcheck.geometry.bevel_play.big_gear_contact`
-(analytic spherical-involute flanks, no mesh). Its contact angle brackets the bisection
+Exact model: for the same poses and scales, :func:`gearcheck.geometry.bevel_play.big_gear_contacts`
+(analytic spherical-involute flanks, no mesh; all the sweep's contacts in one vectorised solve,
+here in the planning process). Its contact angle brackets the bisection
 (:data:`BRACKET_INSIDE_ARCMIN`, :data:`BRACKET_OUTSIDE_ARCMIN`, widened to the mesh-error bound if
 the mesh needs it); the bracket is checked from both sides like any other, so the mesh result
 stands on its own, and it must agree with the exact one within the mesh-error bound (converted
 to an angle on the outer pitch radius d1/2) plus :data:`AGREEMENT_RELATIVE`.
 
-Options: ``angles_per_cycle`` (default :data:`ANGLES_PER_CYCLE`) and ``shims_mm`` (default: the
-template's study shims and 0; the template's own shim is always added).
+Exact range: for each swept shim, the exact least play over the temperature grid of
+:func:`.temperature.temperature_grid` (≤ 5 K steps over the operating and storage ranges), with
+where its contacts lie, as tasks of :data:`RANGE_CHUNK` temperatures each (they share the workers
+with the mesh bisections); the onset of binding is then solved in the reduce step.
+
+Options: ``angles_per_cycle`` (default :data:`ANGLES_PER_CYCLE`), ``shims_mm`` (default: the
+template's study shims and 0; the template's own shim is always added) and ``range_shims``
+("all" swept shims, the default, or "template": the exact range at the template's shim only).
 """
 
 from __future__ import annotations
@@ -60,16 +72,17 @@ from typing import Any
 import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
-from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period, tooth_half_mask, zone_azimuth
+from gearcheck.geometry.bevel_mesh import drive_poses, play_period, tooth_half_mask, zone_azimuth
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.differential.assembly import Layout
+from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, congruent_groups,
+                                                           exact_plays_or_unsolved, meshed_states, placed_gears,
+                                                           temperature_grid)
 from gearcheck.mechanisms.differential.thermal import GearThermal, thermal_state
 from gearcheck.sweep.bodies import Body, MeshData, submesh
 from gearcheck.sweep.engine import Scene, bisect_contact
 from gearcheck.sweep.tools import CountedScene
 
-# Drive angles over one period of the output shafts' play (the whole cycle, see play_period).
-ANGLES_PER_CYCLE = 12
 # Bisection stops when the bracket on the big gear's turn is this narrow.
 BISECTION_TOL_ARCMIN = 1e-4
 # Bracket around the exact contact angle: chords lie inside convex flanks, so the mesh reaches
@@ -80,9 +93,14 @@ BRACKET_INSIDE_ARCMIN = 0.05
 BRACKET_OUTSIDE_ARCMIN = 0.3
 # Pruning: extra teeth kept beyond the exact model's window and the cycle's turn.
 PRUNE_EXTRA_TEETH = 1
-STATES = ("warm", "cold")
+# The states measured at every shim (the others at the template's shim only).
+EVERY_SHIM_STATES = ("warm", "cold")
 DIRECTIONS = (1, -1)
-OPTIONS = ("angles_per_cycle", "shims_mm")
+OPTIONS = ("angles_per_cycle", "shims_mm", "range_shims")
+# Exact range tasks: temperatures per task; their progress weight per temperature, in collide
+# calls (one temperature's exact solves take about as long as this many collide calls).
+RANGE_CHUNK = 6
+RANGE_WEIGHT_PER_TEMPERATURE = 25
 
 
 # --------------------------------------------------------------------------------------------
@@ -92,13 +110,13 @@ def mesh_name(big: str, small: str, direction: int, part: str, state: str) -> st
     return f"{big}|{small}|{'+' if direction > 0 else '-'}|{part}|{state}"
 
 
-def pruned_meshes(bodies: Mapping[str, Body], layout: Layout) -> list[MeshData]:
-    """Per big/small pair, direction and state: the two gears' tooth halves that can touch."""
-    specs, thermal = layout.specs, layout.thermal
+def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: Mapping[str, dict[str, GearThermal]]
+                  ) -> list[MeshData]:
+    """Per big/small pair, direction and state: the two gears' tooth halves that can touch, each
+    gear scaled as in that state."""
+    specs = layout.specs
     big_spec, small_spec = specs.big, specs.small
-    out = []
-    cold = {n: bodies[n].scaled(thermal[n].scale, thermal[n].datum_local).mesh
-            for n in layout.big_gears + layout.small_gears}
+    masks = {}  # the same triangles in every state (a state only scales the vertices)
     for big in layout.big_gears:
         for small in layout.small_gears:
             b, s = bodies[big], bodies[small]
@@ -110,13 +128,15 @@ def pruned_meshes(bodies: Mapping[str, Body], layout: Layout) -> list[MeshData]:
             big_teeth = np.arange(cb - wb, cb + wb + 2)
             small_teeth = np.arange(cs - ws - 1, cs + ws + 1)
             for d in DIRECTIONS:
-                mb = tooth_half_mask(b.mesh.vertices, b.mesh.faces, big_spec, d, big_teeth)
-                ms = tooth_half_mask(s.mesh.vertices, s.mesh.faces, small_spec, d, small_teeth)
-                for state in STATES:
-                    big_mesh = b.mesh if state == "warm" else cold[big]
-                    small_mesh = s.mesh if state == "warm" else cold[small]
-                    out.append(submesh(big_mesh, mesh_name(big, small, d, "big", state), mb))
-                    out.append(submesh(small_mesh, mesh_name(big, small, d, "small", state), ms))
+                masks[(big, small, d)] = (tooth_half_mask(b.mesh.vertices, b.mesh.faces, big_spec, d, big_teeth),
+                                          tooth_half_mask(s.mesh.vertices, s.mesh.faces, small_spec, d, small_teeth))
+    out = []
+    for state, thermal in thermal_by_state.items():
+        scaled = {n: bodies[n].scaled(thermal[n].scale, thermal[n].datum_local).mesh
+                  for n in layout.big_gears + layout.small_gears}
+        for (big, small, d), (mb, ms) in masks.items():
+            out.append(submesh(scaled[big], mesh_name(big, small, d, "big", state), mb))
+            out.append(submesh(scaled[small], mesh_name(big, small, d, "small", state), ms))
     return out
 
 
@@ -153,17 +173,22 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
             "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened}
 
 
-def measure_contact(scene: Scene, big_exact: bp.PlacedGear, small_exact: bp.PlacedGear, direction: int,
-                    meshes: list[tuple], tol_rad: float) -> dict:
-    """Exact contact turn of the big gear one way (analytic flanks), then the mesh contact of
-    each listed pair posed congruently to it: (big_mesh, small_mesh, big_pose, small_pose,
-    bound_rad) — the pair itself and its congruent twins."""
-    t0 = time.perf_counter()
-    exact = bp.big_gear_contact(big_exact, small_exact, direction)
-    exact_s = time.perf_counter() - t0
-    mesh = [_bisect_mesh(scene, bm, sm, bpose, spose, exact.angle_rad, direction, bound, tol_rad)
+def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float) -> dict:
+    """The mesh contact of each listed pair posed congruently to one exact contact (solved in the
+    planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
+    the pair itself and its congruent twins."""
+    mesh = [_bisect_mesh(scene, bm, sm, bpose, spose, exact_rad, direction, bound, tol_rad)
             for bm, sm, bpose, spose, bound in meshes]
-    return {"exact_rad": exact.angle_rad, "exact_on": exact.on, "exact_s": exact_s, "mesh": mesh}
+    return {"exact_rad": exact_rad, "mesh": mesh}
+
+
+def exact_range_task(_scene: Scene, params, shim_mm: float, temperatures_C: list[float], angles_per_cycle: int
+                     ) -> dict:
+    """The exact model alone (no mesh) at some temperatures of the range: the plays over the cycle
+    and where the least-play contacts lie (plain arrays)."""
+    t0 = time.perf_counter()
+    plays = exact_plays_or_unsolved(params, shim_mm, temperatures_C, angles_per_cycle=angles_per_cycle)
+    return {"plays": plays, "exact_s": time.perf_counter() - t0}
 
 
 # --------------------------------------------------------------------------------------------
@@ -176,12 +201,17 @@ class SweepSetup:
     params: Any
     layout: Layout
     bodies: Mapping[str, Body]
-    thermal_at: dict[float, dict[str, GearThermal]]
+    states: list[tuple[str, float]]  # (name, °C) of every state measured (at the template's shim)
+    shim_states: list[list[int]]  # per shim: the indices of the states measured at it
+    thermal_at: dict[tuple[float, str], dict[str, GearThermal]]  # (shim, state) → the gears' state
     shims: list[float]
     angles: np.ndarray
     period_rad: float
-    owners: list[list[tuple]]  # per task: the (shim index, state, angle index, big, small, direction) measured
+    owners: list[list[tuple]]  # per mesh task: the (shim index, state, angle index, big, small, direction) measured
+    range_tasks: list[tuple[int, int]]  # per range task: (shim index, its task index)
+    exact_solves: int
     exact_reused: int
+    exact_s: float  # the planning process's exact solve (all contacts, one vectorised batch)
     bound_mm: float  # the largest pair bound
     bound_arcmin: float  # that bound as an angle on d1/2
     pruned_meshes: int
@@ -197,8 +227,9 @@ def _shims(layout: Layout, shims_mm) -> list[float]:
 
 def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
               options: Mapping[str, Any] | None = None) -> SweepPlan:
-    """Sweep warm and cold over one cycle of the output shafts' play for each shim; one task per
-    distinct exact contact (and direction), with the mesh bisections of every pair congruent to it."""
+    """Sweep each shim's states over one cycle of the output shafts' play; one mesh task per
+    distinct exact contact (and direction), with the mesh bisections of every pair congruent to
+    it; and the exact range tasks."""
     from gearcheck.mechanisms.differential.reduce import reduce_sweep
 
     options = dict(options or {})
@@ -206,89 +237,103 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
     if unknown:
         raise ValueError(f"differential sweep: unknown options {unknown}; known: {list(OPTIONS)}")
     angles_per_cycle = int(options.get("angles_per_cycle", ANGLES_PER_CYCLE))
+    range_shims = options.get("range_shims", "all")
+    if range_shims not in ("all", "template"):
+        raise ValueError(f"differential sweep: range_shims must be 'all' or 'template', not {range_shims!r}")
+    started = time.perf_counter()
     layout: Layout = assembly.layout
     specs, template_shim = layout.specs, layout.template_shim_mm
     bigs, smalls = layout.big_gears, layout.small_gears
     shims = _shims(layout, options.get("shims_mm"))
-    thermal = layout.thermal  # scales and datums: the same for every shim
-    thermal_at = {s: thermal_state(params, specs=specs, shim_mm=s) for s in shims}  # datum shifts
+    states = meshed_states(params)
+    names = [n for n, _ in states]
+    every = [i for i, n in enumerate(names) if n in EVERY_SHIM_STATES]
+    shim_states = [list(range(len(states))) if math.isclose(s, template_shim, abs_tol=1e-9) else every for s in shims]
+    thermal_at = {(s, name): thermal_state(params, cold_C=temp, specs=specs, shim_mm=s)
+                  for s, js in zip(shims, shim_states, strict=True) for name, temp in (states[j] for j in js)}
     built = {n: bodies[n].pose for n in bigs + smalls}
     period = play_period(built, bigs, smalls, specs.big, specs.small)
     angles = np.arange(angles_per_cycle) / angles_per_cycle * period
     d1_half = specs.big.outer_pitch_diameter_mm / 2.0
     tol_rad = BISECTION_TOL_ARCMIN / bp.ARCMIN_PER_RAD
 
-    bound_mm = {}
-    for big in bigs:
-        for small in smalls:
-            bound_mm[(big, small, "warm")] = bodies[big].error_bound_mm + bodies[small].error_bound_mm
-            bound_mm[(big, small, "cold")] = (bodies[big].error_bound_mm * thermal[big].scale
-                                              + bodies[small].error_bound_mm * thermal[small].scale)
+    scales = {name: thermal_at[(template_shim, name)] for name in names}  # the same for every shim
+    bound_mm = {(b, s, name): bodies[b].error_bound_mm * th[b].scale + bodies[s].error_bound_mm * th[s].scale
+                for name, th in scales.items() for b in bigs for s in smalls}
     bound_max_mm = max(bound_mm.values())
 
-    meshes = pruned_meshes(bodies, layout)
-    tasks, owners, reused = [], [], 0
-    for i, shim in enumerate(shims):
-        for state in STATES:
-            for k, phi in enumerate(angles):
-                poses = drive_poses(built, bigs, smalls, specs.big, specs.small, phi, shim - template_shim)
-                placed, mesh_pose = _placed(layout, poses, state, thermal_at[shim])
-                groups, twins = _congruent_groups(layout, placed)
-                reused += twins
-                for gb, gs, members in groups:
-                    for d in DIRECTIONS:
-                        mesh_list = [(mesh_name(b, s, d, "big", state), mesh_name(b, s, d, "small", state),
-                                      mesh_pose[b], mesh_pose[s], bound_mm[(b, s, state)] / d1_half)
-                                     for b, s in members]
-                        tasks.append((measure_contact, (placed[gb], placed[gs], d, mesh_list, tol_rad)))
-                        # the (shim, state, k, big, small, d) measured in this task's mesh list
-                        owners.append([(i, state, k, b, s, d) for b, s in members])
+    meshes = pruned_meshes(bodies, layout, scales)
+    pending, reused, exact, exact_s = _exact_contacts(layout, built, shims, shim_states, names, angles, thermal_at,
+                                                      bound_mm)
+    tasks: list[tuple] = []
+    owners: list[list[tuple]] = []
+    weights: list[int] = []
     # collide calls per pair, for progress: the centred pose, the two bracket ends, the bisection
     per_pair = 3 + math.ceil(math.log2((BRACKET_INSIDE_ARCMIN + BRACKET_OUTSIDE_ARCMIN) / BISECTION_TOL_ARCMIN))
+    for n, (keys, pairs) in enumerate(pending):
+        state = keys[0][1]
+        for d in DIRECTIONS:
+            mesh_list = [(mesh_name(b, s, d, "big", state), mesh_name(b, s, d, "small", state), bpose, spose, bound)
+                         for b, s, bpose, spose, bound in pairs]
+            tasks.append((measure_contact, (exact[d][n].angle_rad, d, mesh_list, tol_rad)))
+            owners.append([key + (d,) for key in keys])
+            weights.append(per_pair * len(pairs))
+    range_tasks = _range_tasks(params, shims, template_shim, range_shims, angles_per_cycle, tasks, weights)
     setup = SweepSetup(
-        params=params, layout=layout, bodies=bodies, thermal_at=thermal_at, shims=shims, angles=angles,
-        period_rad=period, owners=owners, exact_reused=reused, bound_mm=bound_max_mm,
+        params=params, layout=layout, bodies=bodies, states=states, shim_states=shim_states, thermal_at=thermal_at,
+        shims=shims, angles=angles, period_rad=period, owners=owners, range_tasks=range_tasks,
+        exact_solves=len(pending) * len(DIRECTIONS), exact_reused=reused, exact_s=exact_s, bound_mm=bound_max_mm,
         bound_arcmin=bound_max_mm / d1_half * bp.ARCMIN_PER_RAD, pruned_meshes=len(meshes),
-        pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=time.perf_counter())
+        pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started)
     return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
-                     weights=[per_pair * len(o) for o in owners], unit="collide call",
-                     options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims})
+                     weights=weights, unit="collide call",
+                     options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
 
 
-def _placed(layout: Layout, poses: dict[str, np.ndarray], state: str,
-            thermal: dict[str, GearThermal]) -> tuple[dict[str, bp.PlacedGear], dict[str, np.ndarray]]:
-    """The exact gears (pose about the apex, scale) and the meshes' poses, warm or cold."""
-    placed, mesh_pose = {}, {}
-    for name in layout.big_gears + layout.small_gears:
-        spec = layout.specs.big if name in layout.big_gears else layout.specs.small
-        if state == "warm":
-            placed[name] = bp.PlacedGear(spec, poses[name])
-            mesh_pose[name] = poses[name]
-        else:
-            th = thermal[name]
-            placed[name] = bp.PlacedGear(spec, th.cold_pose_about_origin(poses[name]), th.scale)
-            mesh_pose[name] = th.cold_pose(poses[name])
-    return placed, mesh_pose
-
-
-def _congruent_groups(layout: Layout, placed: dict[str, bp.PlacedGear]) -> tuple[list[tuple[str, str, list]], int]:
-    """The big/small pairs at one pose grouped by congruence: one exact solve per distinct mesh. A
-    pair congruent to one already listed (the other output shaft, by the assembly's symmetry)
-    only gets its own mesh bisection, bracketed by that exact contact. Returns the groups (big,
-    small, members) and how many pairs joined an earlier group."""
-    big_spec, small_spec = layout.specs.big, layout.specs.small
-    groups: list[tuple[str, str, list]] = []
+def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list[float], shim_states: list[list[int]],
+                    names: list[str], angles: np.ndarray, thermal_at: Mapping, bound_mm: Mapping):
+    """Every distinct exact contact of the sweep (pairs grouped by congruence at each pose), solved
+    in one vectorised batch per direction. Returns per distinct pair its owners (shim index,
+    state, angle index, big, small) and its mesh pairs (big, small, mesh poses, bound as an angle),
+    how many pairs reuse a solve, the contacts per direction, and the solve's time."""
+    specs, template_shim = layout.specs, layout.template_shim_mm
+    bigs, smalls = layout.big_gears, layout.small_gears
+    d1_half = specs.big.outer_pitch_diameter_mm / 2.0
+    solve: list[tuple[bp.PlacedGear, bp.PlacedGear]] = []
+    pending: list[tuple[list[tuple], list[tuple]]] = []
     reused = 0
-    for big in layout.big_gears:
-        for small in layout.small_gears:
-            q = np.linalg.inv(placed[big].pose) @ placed[small].pose
-            for g in groups:
-                gq = np.linalg.inv(placed[g[0]].pose) @ placed[g[1]].pose
-                same_scales = placed[g[0]].scale == placed[big].scale and placed[g[1]].scale == placed[small].scale
-                if same_scales and congruent(gq, q, big_spec, small_spec, tol=1e-7):
-                    g[2].append((big, small))
-                    reused += 1
-                    break
-            else:
-                groups.append((big, small, [(big, small)]))
-    return groups, reused
+    for i, shim in enumerate(shims):
+        for j in shim_states[i]:
+            state = names[j]
+            thermal = thermal_at[(shim, state)]
+            for k, phi in enumerate(angles):
+                poses = drive_poses(built, bigs, smalls, specs.big, specs.small, phi, shim - template_shim)
+                placed = placed_gears(specs, poses, thermal)
+                mesh_pose = {n: thermal[n].cold_pose(poses[n]) for n in poses}
+                groups, twins = congruent_groups(placed, specs.big, specs.small, bigs, smalls)
+                reused += twins
+                for gb, gs, members in groups:
+                    solve.append((placed[gb], placed[gs]))
+                    pending.append(([(i, state, k, b, s) for b, s in members],
+                                    [(b, s, mesh_pose[b], mesh_pose[s], bound_mm[(b, s, state)] / d1_half)
+                                     for b, s in members]))
+    t0 = time.perf_counter()
+    exact = {d: bp.big_gear_contacts([p[0] for p in solve], [p[1] for p in solve], d) for d in DIRECTIONS}
+    return pending, reused, exact, time.perf_counter() - t0
+
+
+def _range_tasks(params, shims: list[float], template_shim: float, range_shims: str, angles_per_cycle: int,
+                 tasks: list[tuple], weights: list[int]) -> list[tuple[int, int]]:
+    """Append the exact range tasks (the whole grid at each shim, or the template's, in chunks);
+    returns (shim index, task index) of each."""
+    grid = temperature_grid(params).tolist()
+    out = []
+    for i, shim in enumerate(shims):
+        if range_shims == "template" and not math.isclose(shim, template_shim, abs_tol=1e-9):
+            continue
+        for c in range(0, len(grid), RANGE_CHUNK):
+            chunk = grid[c:c + RANGE_CHUNK]
+            out.append((i, len(tasks)))
+            tasks.append((exact_range_task, (params, shim, chunk, angles_per_cycle)))
+            weights.append(RANGE_WEIGHT_PER_TEMPERATURE * len(chunk))
+    return out

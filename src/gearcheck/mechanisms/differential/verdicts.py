@@ -1,5 +1,16 @@
-"""The differential's verdicts at the template's shim: no interference warm, play left cold over
-the whole cycle, and the mesh sweep agreeing with the exact-flank model."""
+"""The differential's verdicts at the template's shim: no interference warm, play left at the cold
+design point over the whole cycle, play over the operating range (binding there fails) and over
+the storage range (binding there only warns, with the temperature where contact starts and how
+deep the flanks overlap at the storage minimum), and the mesh sweep agreeing with the exact-flank
+model.
+
+Evidence. The play verdicts at the meshed states rest on the mesh sweep with the exact model
+agreeing — unless the pipeline found that no practical mesh resolves the smallest play decided
+(``outcome.mesh_resolves`` False: the pair's mesh-error bound exceeds 1/10 of it); then the sign
+of the exact model decides them and the pipeline confirms the worst poses on the exact B-rep. The
+range verdicts rest on the exact model over the whole temperature grid (the mesh samples only the
+range's ends), with the mesh sweep's agreement at the meshed temperatures stated.
+"""
 
 from __future__ import annotations
 
@@ -7,46 +18,165 @@ import math
 
 import numpy as np
 
-from gearcheck.mechanisms.differential.reduce import AGREEMENT_RELATIVE, C, W, SweepData
+from gearcheck.mechanisms.differential.reduce import AGREEMENT_RELATIVE, SweepData
+from gearcheck.mechanisms.differential.temperature import ONSET_TOL_K, shim_text
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
 from gearcheck.results import SweepOutcome, Verdict
+
+EXACT = "exact model (spherical-involute flanks, no mesh)"
+
+
+def _unresolved(data: SweepData) -> str:
+    return (f"; the mesh (pair bound ±{data.bound_mm * 1e3:.1f} µm = ±{data.bound_arcmin:.2f}′ on d1/2) cannot resolve "
+            "the smallest play decided, so the exact model's sign decides, confirmed at the worst poses on the exact "
+            "B-rep")
+
+
+def _play_evidence(data: SweepData, resolves: bool, states: str) -> str:
+    if not resolves:
+        return EXACT + _unresolved(data)
+    return f"mesh sweep (FCL on the built meshes, {states}), exact model agrees"
 
 
 def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
     data: SweepData = outcome.data
-    t, shims, angles = data.t, data.shims, data.angles
+    resolves = bool(getattr(outcome, "mesh_resolves", True))
+    return [_warm(data, resolves), _cold(data, resolves), _operating(params, data, resolves), _storage(params, data),
+            _agreement(data)]
+
+
+def _warm(data: SweepData, resolves: bool) -> Verdict:
+    t, w, angles = data.t, data.w, data.angles
     geom_play, geom_min, exact_min = data.geom_play, data.geom_min, data.exact_min
-    bound_arcmin, total_dev = data.bound_arcmin, data.total_dev
-    warm_free = bool(data.centred_free[t, W].all())
-    least_warm = np.unravel_index(np.argmin(geom_play[t, W]), geom_play[t, W].shape)
+    warm_free = bool(data.centred_free[t, w].all())
+    least = np.unravel_index(np.argmin(geom_play[t, w]), geom_play[t, w].shape)
     n_poses = len(angles) * len(BIG_GEARS) * len(SMALL_GEARS)
-    cold_centred_free = bool(data.centred_free[t, C].all())
-    cold_ok = bool(geom_min[t, C] > 0.0 and exact_min[t, C] > 0.0 and cold_centred_free)
-    return [
-        Verdict.of(
-            "no_interference_warm", f"no interference warm at shim {shims[t]:.2f} mm",
-            warm_free and bool(geom_min[t, W] > 0.0),
-            f"{n_poses} centred poses (4 meshes × {len(angles)} drive angles) free"
-            f"{'' if warm_free else ' — NOT all'}; contact reached both ways at every pose; least warm play "
-            f"{geom_min[t, W]:.3f}′ per side ({BIG_GEARS[least_warm[1]]}, "
-            f"drive {math.degrees(angles[least_warm[0]]):.2f}°), "
-            f"exact {exact_min[t, W]:.3f}′, mesh bound ±{2 * bound_arcmin:.2f}′ on a play",
-            {"centred_poses_free": float(warm_free), "geom_warm_play_min_arcmin": float(geom_min[t, W]),
-             "exact_warm_play_min_arcmin": float(exact_min[t, W])}),
-        Verdict.of(
-            "cold_play_positive", f"cold play > 0 over the whole cycle at shim {shims[t]:.2f} mm", cold_ok,
-            f"least cold play {geom_min[t, C]:.3f}′ per side (geometry), exact {exact_min[t, C]:.3f}′; "
-            f"centred cold poses {'all free' if cold_centred_free else 'COLLIDE'}; worst-case mesh bound "
-            f"±{2 * bound_arcmin:.2f}′ on a play (the mesh matches the exact flanks to "
-            f"{total_dev[t, C].max():.3f}′ here)",
-            {"centred_poses_free": float(cold_centred_free), "geom_cold_play_min_arcmin": float(geom_min[t, C]),
-             "exact_cold_play_min_arcmin": float(exact_min[t, C])}),
-        Verdict.of(
-            "mesh_agrees_with_exact", "mesh sweep agrees with the exact-flank model",
-            data.contact_ok and data.total_ok,
-            f"largest difference {data.contact_dev.max():.3f}′ per contact and {total_dev.max():.3f}′ per play over "
-            f"{data.contacts} contacts; allowed {bound_arcmin:.2f}′ (bound {data.bound_mm * 1e3:.1f} µm on d1/2) + "
-            f"{AGREEMENT_RELATIVE:.0%} per contact, twice the bound per play",
-            {"max_contact_deviation_arcmin": float(data.contact_dev.max()),
-             "max_play_deviation_arcmin": float(total_dev.max()), "mesh_error_bound_arcmin": bound_arcmin}),
-    ]
+    passed = (warm_free and bool(geom_min[t, w] > 0.0)) if resolves else bool(exact_min[t, w] > 0.0)
+    return Verdict.of(
+        "no_interference_warm", f"no interference warm at shim {shim_text(data.shims[t])} mm", passed,
+        f"{n_poses} centred poses (4 meshes × {len(angles)} drive angles) free{'' if warm_free else ' — NOT all'}; "
+        f"contact reached both ways at every pose; least warm play {geom_min[t, w]:.3f}′ per side "
+        f"({BIG_GEARS[least[1]]}, drive {math.degrees(angles[least[0]]):.2f}°), exact {exact_min[t, w]:.3f}′, "
+        f"mesh bound ±{2 * data.bound_arcmin:.2f}′ on a play",
+        {"centred_poses_free": float(warm_free), "geom_warm_play_min_arcmin": float(geom_min[t, w]),
+         "exact_warm_play_min_arcmin": float(exact_min[t, w])},
+        evidence=_play_evidence(data, resolves, f"{data.states[w][1]:g} °C"))
+
+
+def _cold(data: SweepData, resolves: bool) -> Verdict:
+    t, c = data.t, data.c
+    geom_min, exact_min = data.geom_min, data.exact_min
+    centred_free = bool(data.centred_free[t, c].all())
+    if resolves:
+        passed = bool(geom_min[t, c] > 0.0 and exact_min[t, c] > 0.0 and centred_free)
+    else:
+        passed = bool(exact_min[t, c] > 0.0)
+    return Verdict.of(
+        "cold_play_positive", f"cold play > 0 over the whole cycle at shim {shim_text(data.shims[t])} mm, "
+                              f"{data.states[c][1]:g} °C (cold design point)", passed,
+        f"least cold play {geom_min[t, c]:.3f}′ per side (geometry), exact {exact_min[t, c]:.3f}′; "
+        f"centred cold poses {'all free' if centred_free else 'COLLIDE'}; worst-case mesh bound "
+        f"±{2 * data.bound_arcmin:.2f}′ on a play (the mesh matches the exact flanks to "
+        f"{np.nanmax(data.total_dev[t, c]):.3f}′ here)",
+        {"centred_poses_free": float(centred_free), "geom_cold_play_min_arcmin": float(geom_min[t, c]),
+         "exact_cold_play_min_arcmin": float(exact_min[t, c])},
+        evidence=_play_evidence(data, resolves, f"{data.states[c][1]:g} °C"))
+
+
+def _unsolved(r, lo: float, hi: float) -> str:
+    out = [t for t in r.unsolved_C if lo - 1e-9 <= t <= hi + 1e-9]
+    return (f"; the exact model found no contact within its reach at {', '.join(f'{t:g}' for t in out)} °C"
+            if out else "")
+
+
+def _meshed_within(data: SweepData, lo: float, hi: float) -> list[int]:
+    return [j for j, (_, temp) in enumerate(data.states) if lo - 1e-9 <= temp <= hi + 1e-9 and data.measured[data.t, j]]
+
+
+def _grid_text(data: SweepData, lo: float, hi: float) -> str:
+    r = data.range
+    n = int(np.sum((r.temperatures_C >= lo - 1e-9) & (r.temperatures_C <= hi + 1e-9)))
+    return f"{n} temperatures over {lo:g}…{hi:g} °C in ≤ {np.max(np.diff(r.temperatures_C), initial=0):.0f} K steps"
+
+
+def _mesh_text(data: SweepData, states: list[int]) -> str:
+    t = data.t
+    return ", ".join(f"{data.states[j][1]:g} °C geometry {data.geom_min[t, j]:.3f}′ / exact {data.exact_min[t, j]:.3f}′"
+                     for j in states)
+
+
+def _operating(params, data: SweepData, resolves: bool) -> Verdict:
+    op = params.operating
+    r = data.range
+    least, at = r.operating
+    meshed = _meshed_within(data, op.operating_min_C, op.operating_max_C)
+    mesh_least = min((float(data.geom_min[data.t, j]) for j in meshed), default=math.inf)
+    passed = least > 0.0 and (mesh_least > 0.0 or not resolves)
+    evidence = f"{EXACT}, {_grid_text(data, op.operating_min_C, op.operating_max_C)}"
+    evidence += f"; mesh sweep agrees at {', '.join(f'{data.states[j][1]:g}' for j in meshed)} °C" if resolves else \
+        _unresolved(data)
+    figures = {"exact_operating_least_play_arcmin": least, "exact_operating_least_play_at_C": at}
+    if math.isfinite(mesh_least):
+        figures["geom_operating_least_play_arcmin"] = mesh_least
+    return Verdict.of(
+        "operating_play_positive",
+        f"play > 0 over the operating range {op.operating_min_C:g}…{op.operating_max_C:g} °C at shim "
+        f"{shim_text(data.shims[data.t])} mm", passed,
+        f"least exact play {least:.3f}′ per side at {at:g} °C"
+        + (f" — binds: the flanks overlap by {r.depth_um(least):.2f} µm on d1/2" if least <= 0 else "")
+        + _unsolved(r, op.operating_min_C, op.operating_max_C) + f"; meshed: {_mesh_text(data, meshed)}",
+        figures, evidence=evidence)
+
+
+def _storage(params, data: SweepData) -> Verdict:
+    op = params.operating
+    r = data.range
+    least, at = r.storage
+    onset = r.cold_onset_C if r.cold_onset_C is not None and r.cold_onset_C >= op.storage_min_C else r.hot_onset_C
+    figures = {"exact_storage_least_play_arcmin": least, "exact_storage_least_play_at_C": at,
+               "exact_storage_min_play_arcmin": r.at("storage_min"),
+               "overlap_at_storage_min_um": r.depth_um(r.at("storage_min"))}
+    meshed = _meshed_within(data, op.storage_min_C, op.storage_max_C)
+    evidence = (f"{EXACT}, {_grid_text(data, op.storage_min_C, op.storage_max_C)}; mesh sweep at "
+                f"{', '.join(f'{data.states[j][1]:g}' for j in meshed)} °C beside it")
+    if least > 0.0:
+        return Verdict.of(
+            "storage_play_positive",
+            f"play > 0 over the storage range {op.storage_min_C:g}…{op.storage_max_C:g} °C at shim "
+            f"{shim_text(data.shims[data.t])} mm", True,
+            f"least exact play {least:.3f}′ per side at {at:g} °C; meshed: {_mesh_text(data, meshed)}", figures,
+            evidence=evidence)
+    if not math.isfinite(least):
+        return Verdict.graded(
+            "storage_play_positive",
+            f"play > 0 over the storage range {op.storage_min_C:g}…{op.storage_max_C:g} °C at shim "
+            f"{shim_text(data.shims[data.t])} mm", "warn",
+            "not decided" + _unsolved(r, op.storage_min_C, op.storage_max_C), figures, evidence=evidence)
+    if onset is not None:
+        figures["binding_onset_C"] = onset
+    deep = r.at("storage_min")
+    where = (f"contact starts at {onset:.2f} °C (exact model, ±{ONSET_TOL_K:g} K)" if onset is not None
+             else "binds at every storage temperature checked")
+    also = " (and in the operating range: see operating_play_positive)" if r.binds_operating else \
+        f"; the operating range stays free (least {r.operating[0]:.3f}′ at {r.operating[1]:g} °C)"
+    return Verdict.graded(
+        "storage_play_positive",
+        f"play > 0 over the storage range {op.storage_min_C:g}…{op.storage_max_C:g} °C at shim "
+        f"{shim_text(data.shims[data.t])} mm", "warn",
+        f"binds in storage: {where}; at the storage minimum {op.storage_min_C:g} °C the flanks overlap by "
+        f"{-deep:.3f}′ per side ({r.depth_um(deep):.2f} µm on d1/2){also}; meshed: {_mesh_text(data, meshed)}",
+        figures, evidence=evidence)
+
+
+def _agreement(data: SweepData) -> Verdict:
+    total_dev = data.total_dev
+    return Verdict.of(
+        "mesh_agrees_with_exact", "mesh sweep agrees with the exact-flank model",
+        data.contact_ok and data.total_ok,
+        f"largest difference {data.contact_dev.max():.3f}′ per contact and {np.nanmax(total_dev):.3f}′ per play over "
+        f"{data.contacts} contacts at {int(data.measured.sum())} shim/temperature states; allowed "
+        f"{data.bound_arcmin:.2f}′ (bound {data.bound_mm * 1e3:.1f} µm on d1/2) + {AGREEMENT_RELATIVE:.0%} per "
+        "contact, twice the bound per play",
+        {"max_contact_deviation_arcmin": float(data.contact_dev.max()),
+         "max_play_deviation_arcmin": float(np.nanmax(total_dev)), "mesh_error_bound_arcmin": data.bound_arcmin},
+        evidence="mesh sweep against the exact model, contact by contact")

@@ -51,7 +51,8 @@ def calc(params: Params) -> list[Figure]:
 
     # --- towing push model -----------------------------------------------------------------
     max_deg = params.towing.max_angle_deg
-    tow = an.analyse_towing(g, max_deg, extra_deg=an.CHECK_ANGLES_DEG + (P["adams_disengage_deg"],))
+    adams = (P["adams_disengage_deg"],) if an.is_paper_design(params) else ()  # as the sweep's model
+    tow = an.analyse_towing(g, max_deg, extra_deg=an.CHECK_ANGLES_DEG + adams)
     dis_deg = _deg(tow.disengage_rad)
 
     def travel_at(angle_deg: float) -> float:
@@ -157,17 +158,8 @@ def calc(params: Params) -> list[Figure]:
         F("ddisengage_dRS1_deg_per_mm", "sensitivity dφ(disengage)/dRS1", dphi_drs1, "deg/mm", digits=2),
         F("dphiS6_dhS6_deg_per_mm", "sensitivity dφS6/dhS6", dphi_dhs6, "deg/mm", digits=2),
     ]
-    # A solved trim the model has no value for is left out (no null in calc --json); the table says
-    # so beside the solved L(S3/S4), which the solver starts from.
-    none = [f"{name}: none in range ({why})" for key, name, why in (
-        ("RS1_solved_mm", "RS1 solved", "no RS1 up to Ra reaches the target"),
-        ("hS2_solved_mm", "hS2 solved", "no hS2 up to the rack top gives equal travel"))
-        if not math.isfinite(next(f.value for f in figures if f.key == key))]
-    figures = [dataclasses.replace(f, note="; ".join(none)) if f.key == "travel_S3S4_solved_mm" and none else f
-               for f in figures
-               if not (f.key in ("RS1_solved_mm", "hS2_solved_mm") and not math.isfinite(f.value))]
     if an.is_paper_design(params):
-        return figures
+        return _without_missing(figures, params, tow)
     # another design: no printed targets, no notes about the paper's figures, no sample at ADAMS's angle
     keep = {"contact_ratio", "continuous_margin_deg", "towing_max_overlap_mm", "towing_grazing_span_deg",
             "travel_S3S4_solved_mm", "reengage_angle_deg"}
@@ -181,4 +173,51 @@ def calc(params: Params) -> list[Figure]:
         elif f.key not in keep and note != beyond:
             note = ""
         out.append(dataclasses.replace(f, paper=None, note=note))
+    return _without_missing(out, params, tow)
+
+
+# Where a figure without a value is accounted for in the table: the row whose note says why (the
+# solved trims beside the solved L(S3/S4) the solver starts from, the towing figures beside the
+# travel at the end of the swing, which always has one).
+TRIM_KEYS = ("RS1_solved_mm", "hS2_solved_mm")
+TOWING_KEYS = ("disengage_angle_deg", "disengage_angle_paper_bookkeeping_deg", "rack_travel_at_disengage_mm",
+               "towing_grazing_span_deg", "reengage_angle_deg", "towing_travel_mm_at_068deg",
+               "towing_travel_mm_at_072deg", "towing_travel_mm_at_075deg", "towing_travel_mm_at_adams_angle")
+
+
+def _why_missing(key: str, params: Params, tow) -> str:
+    """Why the model has no value for ``key`` (a figure of :func:`calc`)."""
+    max_deg = params.towing.max_angle_deg
+    if key.startswith("towing_travel_mm_at_"):
+        return f"beyond towing.max_angle_deg = {max_deg:g}°"
+    why = {"RS1_solved_mm": "no RS1 up to Ra reaches the target",
+           "hS2_solved_mm": "no hS2 up to the rack top gives equal travel",
+           "reengage_angle_deg": "the return swing never picks the rack up again"}
+    if key in why:
+        return why[key]
+    if math.isnan(tow.disengage_rad):
+        return f"the rack is still moving at towing.max_angle_deg = {max_deg:g}°"
+    if key == "towing_grazing_span_deg":
+        return "the tip land still touches the stop corner at the end of the swing"
+    return "the model has no value for this design"
+
+
+def _without_missing(figures: list[Figure], params: Params, tow) -> list[Figure]:
+    """The figures with a value; each one without (NaN) is left out — calc --json has no null — and
+    named with its reason in the note of the row that accounts for it (the row before it when none
+    does): "label, label: — (why)"."""
+    anchors = {key: "travel_S3S4_solved_mm" for key in TRIM_KEYS}
+    anchors.update({key: "towing_travel_mm_at_max_angle" for key in TOWING_KEYS})
+    missing: dict[str, dict[str, list[str]]] = {}  # anchor → why → labels
+    kept: list[Figure] = []
+    for f in figures:
+        if math.isfinite(f.value):
+            kept.append(f)
+            continue
+        anchor = anchors.get(f.key) or (kept[-1].key if kept else "")
+        missing.setdefault(anchor, {}).setdefault(_why_missing(f.key, params, tow), []).append(f.label)
+    out = []
+    for f in kept:
+        extra = [f"{', '.join(labels)}: — ({why})" for why, labels in missing.get(f.key, {}).items()]
+        out.append(dataclasses.replace(f, note="; ".join(filter(None, [f.note, *extra]))) if extra else f)
     return out

@@ -18,7 +18,7 @@ from gearcheck.mechanisms.steering.params import Params as SteeringParams
 if TYPE_CHECKING:
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
-    from gearcheck.results import Report, SweepOutcome, Verdict
+    from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body
 
 
@@ -35,6 +35,14 @@ class Steering(Mechanism):
     template: ClassVar[str | None] = "nose_wheel_steering.toml"
     fuzz_seed_base: ClassVar[int] = 2_000_000
     nan_figures: ClassVar[frozenset[str]] = _sampling.NAN_FIGURES
+
+    def smallest_clearance(self, params: SteeringParams) -> Clearance | None:
+        """None: the steering check decides no non-zero clearance. Its flanks mesh at zero backlash
+        (contact and interference are decided within the contact tolerance), the stop and the
+        re-engagement are events bracketed by bisection on the pinion angle, the grazing past the
+        stop is at zero clearance, and the continuous drive rests on contact positions (where a
+        pair's tangency point leaves a flank), not on a gap between parts."""
+        return None
 
     def analyse(self, params: SteeringParams) -> list[Figure]:
         return _calc.calc(params)

@@ -121,3 +121,10 @@ def driving_flank(g: RackPinionGeometry, rack: MeshData, right: np.ndarray, corn
     up = np.array([-normal[1], normal[0]])
     up = up if up[1] > 0 else -up
     return normal, up
+
+
+def rack_profile(rack: MeshData) -> np.ndarray:
+    """The rack's outline vertices as the mesh has them (own frame, xy): those on one end face,
+    exact points of the B-rep outline (every wall triangle spans the face width)."""
+    v = rack.vertices
+    return v[np.abs(v[:, 2] - v[:, 2].max()) < 1e-6][:, :2]

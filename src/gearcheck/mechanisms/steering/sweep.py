@@ -1,6 +1,8 @@
 """The steering sweep as a plan (towing both ways, power mode both ways, on the built meshes) and
 its reduction: per-pose rows against the push model and the power-mode model, the figures of
-each direction, the summary and the poses to confirm exactly.
+each direction, every tooth pair's conjugate contact interval measured at the swept poses and the
+continuous drive they give (:mod:`.handover`; poses are added around every tight hand-over the
+exact model predicts), the summary and the poses to confirm exactly.
 
 What each task does: :mod:`.tasks`. The + direction is the paper's (φ > 0, the first rack tooth
 k = rack.first_tooth comes under the pinion); the − direction is its mirror image, swept on the
@@ -12,16 +14,17 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
 from gearcheck.geometry.rack_pinion_contact import stop_phrase, whole_drive
-from gearcheck.geometry.rack_pinion_power import power_model_travel
+from gearcheck.geometry.rack_pinion_power import power_corner, power_model_travel
 from gearcheck.mechanism import Assembly, SweepPlan, Task
 from gearcheck.mechanisms.steering import analysis as an
+from gearcheck.mechanisms.steering import handover as ho
 from gearcheck.mechanisms.steering import meshes as ms
 from gearcheck.mechanisms.steering.meshes import PINION, RACK
 from gearcheck.results import SweepOutcome, WorstPose
@@ -45,6 +48,10 @@ OPTIONS = {"towing_step_deg": TOWING_STEP_DEG, "power_step_deg": POWER_STEP_DEG}
 # the angle step, plus the contact tolerance (a pose that starts in contact). Power mode: the
 # rack turns the pinion at most REACH_MARGIN / (centre height − rack top) rad per mm.
 REACH_MARGIN = 1.5
+# The power stroke reaches at least this far past the model's power-drive limit (deg of pinion
+# angle), and at most this share of the travel at which S6 leaves the tip circle (the release).
+POWER_PAST_LIMIT_DEG = 1.0
+POWER_RELEASE_SHARE = 0.99
 
 
 def sign(direction: int) -> str:
@@ -101,6 +108,14 @@ class SteeringSweep:
     speed: dict
     travel_at_adams_mm: float  # mesh towing travel at the grid angle nearest ADAMS's disengage
     least_drive_deg: float = math.nan  # continuous_drive_deg: least of the model and the mesh
+    # (mode, direction) → the mesh's continuous drive from the contact intervals it measured
+    drives: dict = field(default_factory=dict)
+    # how far the mesh's contact ends may lie from the exact model's (deg): the angle of one contact
+    # tolerance of rack travel, r·Δφ = tol (the meshed rack lags the exact one by up to the chord sag)
+    handover_tol_deg: float = math.nan
+
+    def drive(self, mode: str, direction: int) -> ho.MeshDrive:
+        return self.drives[(mode, direction)]
 
 
 def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None = None
@@ -117,8 +132,11 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     opts.update(options or {})
     layout = assembly.layout
     g = layout.geometry
+    paper = an.is_paper_design(params)
+    # a pose at the angle of the paper's ADAMS stop, for the comparison beside the paper's own design
+    adams = (an.PAPER["adams_disengage_deg"],) if paper else ()
     tow_model = an.analyse_towing(g, layout.towing_max_angle_deg,
-                                  extra_deg=an.CHECK_ANGLES_DEG + (an.PAPER["adams_disengage_deg"],))
+                                  extra_deg=an.CHECK_ANGLES_DEG + adams)
     model = ModelFigures.of(g, tow_model)
 
     pinion, rack = bodies[PINION], bodies[RACK]
@@ -135,12 +153,21 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     normal, up = ms.driving_flank(g, rack.mesh, flanks[1], corner)
     profile = ms.pinion_profile(pinion.mesh)
 
+    # extra poses around every tight hand-over the exact model predicts (and inside any gap)
     angles = an.towing_grid(layout.towing_max_angle_deg, opts["towing_step_deg"],
-                            an.CHECK_ANGLES_DEG + (an.PAPER["adams_disengage_deg"],))
-    # power mode over the towing stroke of the model (past the S6 limit, short of the release)
-    stroke = float(tow_model.forward.travel_mm[-1])
+                            an.CHECK_ANGLES_DEG + adams
+                            + tuple(ho.extra_angles_deg(g, "towing", layout.towing_max_angle_deg)))
+    # power mode over the towing stroke of the model (past the S6 limit, short of the release), and at
+    # least a little past the model's power-drive limit when the towing swing is short of it
+    beyond_limit = g.pitch_radius * math.radians(model.power_drive_deg + POWER_PAST_LIMIT_DEG)
+    stroke = max(float(tow_model.forward.travel_mm[-1]), min(beyond_limit, POWER_RELEASE_SHARE * power_corner(g)[2]))
     n_power = max(int(math.ceil(math.degrees(stroke / g.pitch_radius) / opts["power_step_deg"])), 2)
-    travels = np.linspace(0.0, stroke, n_power + 1)
+    extra_travels = [g.pitch_radius * math.radians(a) for a in ho.extra_angles_deg(g, "power", math.inf)]
+    travels = np.unique(np.concatenate([np.linspace(0.0, stroke, n_power + 1),
+                                        [t for t in extra_travels if t < stroke]]))
+    rack_points = ms.rack_profile(rack.mesh)
+    flank_pairs = {(mode, d): ho.flank_pairs(g, profile, rack_points, kin.rack(0.0), mode, d)
+                   for mode in ho.MODES for d in (+1, -1)}
     reach_travel_per_rad = tip * an.PUSH_RATE_PER_TIP_RADIUS
     reach_angle_per_mm = REACH_MARGIN / (centre_height - rack_top)
 
@@ -151,10 +178,10 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
               for d, m in ((+1, np.ones(2)), (-1, mirror))]
     weights = [2 * len(angles)] * 2 + [len(travels)] * 2  # poses per task
 
-    paper = an.is_paper_design(params)
 
     def reduce(results: list) -> SweepOutcome:
-        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper)
+        drives = _mesh_drives(g, kin, flank_pairs, results)
+        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives)
 
     return SweepPlan(meshes, tasks, reduce, weights, "pose", opts)
 
@@ -223,7 +250,8 @@ def towing_conjugate_end(g: RackPinionGeometry, r: dict, tol: float) -> float:
     return float(a0 + (a1 - a0) * (-l0) / (l1 - l0))
 
 
-def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, towing_end: float) -> dict:
+def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, towing_end: float,
+                       towing: ho.MeshDrive, power: ho.MeshDrive) -> dict:
     """Geometry figures of one direction (angle and travel magnitudes)."""
     deg = math.degrees
     out = r["angles_out"]
@@ -246,6 +274,18 @@ def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, to
         "geom_rack_travel_at_continuous_limit_mm": abs(p["limit_travel"]),
         "geom_raw_corner_contact_angle_deg": abs(deg(p["raw_corner_angle"])),
         "geom_towing_conjugate_end_deg": deg(towing_end),
+        # how far each sweep reaches: a drive figure there is only a lower bound (nothing ended within it)
+        "geom_towing_swing_end_deg": abs(deg(float(out[-1]))),
+        "geom_power_stroke_end_deg": abs(deg(float(p["angles"][-1]))),
+        # continuous drive from the conjugate contact intervals of every pair measured on the meshes
+        "geom_towing_drive_deg": towing.angle_deg,
+        "geom_power_drive_deg": power.angle_deg,
+        **({"geom_towing_gap_deg": list(towing.gap_deg), "geom_towing_gap_poses": towing.gap_poses}
+           if towing.gap_deg else {}),
+        **({"geom_power_gap_deg": list(power.gap_deg), "geom_power_gap_poses": power.gap_poses}
+           if power.gap_deg else {}),
+        "max_handover_deviation_deg": _largest(towing.max_deviation_deg, power.max_deviation_deg),
+        "max_flank_fit_residual_mm": _largest(towing.fit_residual_mm, power.fit_residual_mm),
         # the rack still moving at the end of the swing: it moved more than the contact tolerance
         # over the last degree of the forward swing (no disengage within towing.max_angle_deg)
         "geom_rack_motion_last_degree_mm": last_degree,
@@ -261,14 +301,102 @@ def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, to
     }
 
 
+def _mesh_drives(g: RackPinionGeometry, kin: Kinematics, flank_pairs: dict, results: list) -> dict:
+    """(mode, direction) → the mesh's continuous drive from the contact intervals measured at the
+    swept poses (towing: the forward swing; power: the rack's stroke)."""
+    axis = np.asarray(kin.rack_motion.axis, float)
+    out = {}
+    for r in results:
+        mode = "towing" if "angles_out" in r else "power"
+        angles, travels = (r["angles_out"], r["travel_out"]) if mode == "towing" else (r["angles"], r["travels"])
+        poses = np.array([kin.pinion(float(a)) for a in angles])
+        d = r["direction"]
+        measured, covered = ho.measured_pairs(g, mode, flank_pairs[(mode, d)], angles, travels, poses, axis)
+        out[(mode, d)] = ho.mesh_drive(g, mode, d, measured, angles, covered, flank_pairs[(mode, d)])
+    return out
+
+
+# Figures of the stop, which mean nothing while the rack is still moving at the end of the swing.
+STOP_KEYS = ("geom_disengage_angle_deg", "geom_rack_travel_at_disengage_mm", "geom_rack_motion_after_disengage_mm",
+             "geom_grazing_span_deg", "geom_disengage_bracket_at_tol_deg", "min_clearance_past_disengage_mm",
+             "graze_distance_mm", "graze_angle_deg", "graze_contact_shift_mm")
+
+
+def still_moving(s: dict, model_moving: bool, tol: float) -> bool:
+    """The rack is still moving at the end of the towing swing: in the model (no disengage) or in
+    this direction of the mesh (it moved more than the contact tolerance over the last degree)."""
+    return model_moving or not s["geom_rack_motion_last_degree_mm"] <= tol
+
+
+def _stated(s: dict, model_moving: bool, tol: float) -> dict:
+    """One direction's figures for summary.json: without the stop's while the rack is still moving
+    (the 'disengage' found there is only the end of the swing)."""
+    if not still_moving(s, model_moving, tol):
+        return dict(s)
+    return {k: v for k, v in s.items() if k not in STOP_KEYS}
+
+
+def _finite(tree: dict) -> dict:
+    """summary.json has no null: a figure without a value (NaN; a list holding one) is left out."""
+    out: dict = {}
+    for k, v in tree.items():
+        if isinstance(v, dict):
+            out[k] = _finite(v)
+        elif isinstance(v, (list, tuple)):
+            if all(isinstance(x, (int, float)) and math.isfinite(x) for x in v):
+                out[k] = v
+        elif not (isinstance(v, float) and not math.isfinite(v)):
+            out[k] = v
+    return out
+
+
+Figure = tuple[float, str]  # a continuous-drive angle (deg) and the event that ends it
+
+
+def drive_figures(model: ModelFigures, plus: dict, minus: dict, drives: dict, tol: float
+                  ) -> tuple[list[Figure], list[Figure], list[Figure]]:
+    """The continuous-drive figures: the exact model's (towing, power), the mesh sweep's limits (the
+    contact intervals of every pair, towing and power; the power-mode contact reaching S6; the towed
+    rack falling ``tol`` behind r·φ; each direction) and the mesh figures that are only lower bounds
+    (the event lies beyond the sweep: the towing swing, the power stroke)."""
+    model_c = [(model.towing_drive_deg, f"exact model, {model.towing_drive_event}"),
+               (model.power_drive_deg, f"exact model, {model.power_drive_event}")]
+    limits: list[Figure] = []
+    bounds: list[Figure] = []
+    for s, d in ((plus, +1), (minus, -1)):
+        for mode in ("towing", "power"):
+            drive = drives[(mode, d)]
+            (bounds if drive.bounded else limits).append(
+                (drive.angle_deg, f"mesh sweep, {sign(d)} direction, {drive.event}"))
+        s6, stroke = s["geom_continuous_angle_deg"], s["geom_power_stroke_end_deg"]
+        if math.isfinite(s6):
+            limits.append((s6, f"mesh sweep, {sign(d)} direction: power-mode contact reaches S6 (tangency)"))
+        else:
+            bounds.append((stroke, f"mesh sweep, {sign(d)} direction: power-mode contact short of S6 to the end "
+                                   "of the stroke"))
+        lag, swing = s["geom_towing_conjugate_end_deg"], s["geom_towing_swing_end_deg"]
+        if lag < swing:
+            limits.append((lag, f"mesh sweep, {sign(d)} direction: towed rack falls {tol:.3f} mm behind r·φ"))
+        else:
+            bounds.append((swing, f"mesh sweep, {sign(d)} direction: towed rack never falls {tol:.3f} mm behind "
+                                  "r·φ within the swing"))
+    return model_c, limits, bounds
+
+
 def _least(*values: float) -> float:
     """The least finite value (NaN when there is none)."""
     finite = [v for v in values if math.isfinite(v)]
     return min(finite) if finite else math.nan
 
 
+def _largest(*values: float) -> float:
+    """The largest finite value (NaN when there is none)."""
+    finite = [v for v in values if math.isfinite(v)]
+    return max(finite) if finite else math.nan
+
+
 def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results: list, tol: float, bound: float,
-            mesh_info: dict, t_start: float, paper: bool = True) -> SweepOutcome:
+            mesh_info: dict, t_start: float, paper: bool = True, drives: dict | None = None) -> SweepOutcome:
     P = an.PAPER
     tow = {r["direction"]: r for r in results[:2]}
     power = {r["direction"]: r for r in results[2:]}
@@ -277,8 +405,11 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     rows, towing_dev, curves = _towing_rows(g, tow)
     power_rows, power_dev = _power_rows(g, power)
     rows += power_rows
+    drives = drives or {}
     plus, minus = (_direction_summary(tow[d], power[d], towing_dev[d], power_dev[d],
-                                      towing_conjugate_end(g, tow[d], tol)) for d in (+1, -1))
+                                      towing_conjugate_end(g, tow[d], tol), drives[("towing", d)],
+                                      drives[("power", d)]) for d in (+1, -1))
+    model_c, limits, _ = drive_figures(model, plus, minus, drives, tol)
     queries = sum(r["queries"] for r in results)
     speed = {"poses": len(rows), "fcl_queries": queries, "elapsed_s": elapsed, "poses_per_s": len(rows) / elapsed,
              "fcl_queries_per_s": queries / elapsed, "task_seconds": [float(r["seconds"]) for r in results],
@@ -287,7 +418,7 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     speed["fcl_queries_per_cpu_s"] = queries / sum(speed["task_cpu_seconds"])
 
     summary = {
-        **plus,
+        **_stated(plus, model.moving_at_end, tol),
         "model_disengage_angle_deg": model.disengage_deg,
         "paper_disengage_angle_deg": P["disengage_deg"],
         "paper_adams_disengage_angle_deg": P["adams_disengage_deg"],
@@ -301,9 +432,8 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "model_continuous_angle_deg": model.continuous_deg,
         "model_continuous_towing_deg": model.towing_drive_deg,
         "model_continuous_power_deg": model.power_drive_deg,
-        "continuous_drive_deg": _least(model.towing_drive_deg, model.power_drive_deg,
-                                      *(s["geom_continuous_angle_deg"] for s in (plus, minus)),
-                                      *(s["geom_towing_conjugate_end_deg"] for s in (plus, minus))),
+        "continuous_drive_deg": _least(*(f[0] for f in model_c + limits)),
+        "mesh_continuous_drive_deg": _least(*(f[0] for f in limits)),
         "model_contact_ratio": model.contact_ratio,
         "paper_continuous_angle_deg": P["phi_S6_deg"],
         "paper_test_continuous_angle_deg": P["test_continuous_deg"],
@@ -311,13 +441,14 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "min_signed_clearance_mm": min(plus["min_signed_clearance_mm"], minus["min_signed_clearance_mm"]),
         "contact_tolerance_mm": tol,
         "mesh_error_bound_mm": bound,
-        "minus": minus,
+        "minus": _stated(minus, model.moving_at_end, tol),
         "poses": speed["poses"],
         "fcl_queries": speed["fcl_queries"],
         **mesh_info,
     }
     if not paper:  # the paper's printed figures stand only beside the paper's own design
         summary = {k: v for k, v in summary.items() if not k.startswith("paper_")}
+    summary = _finite(summary)
 
     out_deg = np.degrees(tow[1]["angles_out"])
     travel_at_adams = float(tow[1]["travel_out"][int(np.argmin(np.abs(out_deg - P["adams_disengage_deg"])))])
@@ -325,9 +456,10 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     worst_poses = [
         WorstPose(f"towing {sign(d)}: closest approach past the disengage ({over})", PINION, RACK,
                   kin.pinion(w["angle"]).tolist(), kin.rack(w["travel"]).tolist(), float(w["distance"]))
-        for d in (+1, -1) if (w := tow[d]["worst"])
+        for d, s in ((+1, plus), (-1, minus))
+        if (w := tow[d]["worst"]) and not still_moving(s, model.moving_at_end, tol)  # no stop: nothing past it
     ]
     data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
-                         summary["continuous_drive_deg"])
+                         summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius))
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}
     return SweepOutcome(summary, worst_poses, None, timings, data)

@@ -62,6 +62,13 @@ class TrackDrive(Mechanism):
 
         return track_report(outcome, verdicts)
 
+    def study_row(self, params: TrackParams, level: str) -> dict[str, float]:
+        if level == "exact":
+            from gearcheck.mechanisms.track.study import exact_row
+
+            return exact_row(track_assembly(params).layout)
+        return super().study_row(params, level)
+
     def sample(self, data: dict, draw: Any) -> None:
         from gearcheck.mechanisms.track.sampling import sample_track
 

@@ -77,6 +77,11 @@ def _outline_near_groove(gap: iso606.ToothGap, step_mm: float) -> np.ndarray:
     return np.vstack(pieces)
 
 
+def seat_polyline(gap: iso606.ToothGap) -> np.ndarray:
+    """The groove's outline for :func:`seat_check` (made once per gap, reused across elongations)."""
+    return _outline_near_groove(gap, SEAT_OUTLINE_STEP_MM)
+
+
 def _nearest(point: np.ndarray, poly: np.ndarray) -> tuple[float, np.ndarray]:
     """Distance from ``point`` to the open polyline ``poly`` and the nearest point on it."""
     a, b = poly[:-1], poly[1:]

@@ -1,0 +1,174 @@
+"""A study file: which template, the distributions over its inputs, the outputs to collect, the
+failures to count, how many variants and which seed.
+
+Study files are TOML, like templates, and ship beside them (``gearcheck/studies/``). Each input
+names a template field (``section.key``), a distribution centred on the template's value unless a
+``mean`` is given, its unit and the reason for its width (an accuracy grade, a drawing tolerance, a
+data-sheet spread). Bad input is one line naming the field, its value and the allowed range
+(:class:`gearcheck.ParamError`), as for templates.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, model_validator
+
+from gearcheck.params import ParamError, read_toml, validate
+from gearcheck.params.common import Section
+
+# A study's size limits: enough for any tolerance study, small enough that a typo cannot ask for
+# a week of CPU (the analytical level is vectorised and takes far more; the API can pass more).
+MAX_SAMPLES = 1_000_000
+MAX_EXACT = 100_000
+MAX_CHECKS = 20
+LEVELS = ("analytical", "exact", "check")
+
+FieldPath = Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)+$", max_length=120)]
+Text = Annotated[str, Field(min_length=1, max_length=400)]
+
+
+class Input(Section):
+    """One sampled template field: its value ("value"), or a deviation added to it ("offset":
+    centred on 0 unless a mean is given; several offsets may act on one field, e.g. chain wear
+    and the pitch tolerance both lengthen the chain's pitch)."""
+
+    field: FieldPath
+    name: Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,63}$")] | None = None  # default: the field
+    mode: Literal["value", "offset"] = "value"
+    # other template fields that take the same value (a shim both built and measured with)
+    also: Annotated[list[FieldPath], Field(max_length=8)] = []
+    distribution: Literal["normal", "truncnorm", "uniform"]
+    unit: Annotated[str, Field(max_length=20)]
+    reason: Text
+    mean: float | None = None  # default: the template's value
+    sd: Annotated[float, Field(ge=0.0)] | None = None
+    low: float | None = None
+    high: float | None = None
+    integer: bool = False  # round each draw to the nearest integer (tooth counts)
+
+    @property
+    def key(self) -> str:
+        """The input's column: its name, else its field."""
+        return self.name or self.field
+
+    @model_validator(mode="after")
+    def _shape(self) -> Input:
+        d = self.distribution
+        where = f"inputs[{self.key}]"
+        if d in ("normal", "truncnorm") and self.sd is None:
+            raise ParamError(f"{where}.sd", "missing", f"required for a {d} distribution: a standard deviation ≥ 0")
+        if d == "uniform" and (self.low is None or self.high is None):
+            raise ParamError(f"{where}.low/high", "missing", "required for a uniform distribution: low ≤ high")
+        if d == "truncnorm" and self.low is None and self.high is None:
+            raise ParamError(f"{where}.low/high", "missing", "a truncated normal needs low, high or both")
+        if self.low is not None and self.high is not None and not self.low <= self.high:
+            raise ParamError(f"{where}.high", self.high, f"allowed ≥ low = {self.low:g}")
+        if d == "uniform" and (self.mean is not None or self.sd is not None):
+            raise ParamError(f"{where}.mean/sd", self.mean if self.mean is not None else self.sd,
+                             "a uniform distribution takes only low and high")
+        return self
+
+
+class Failure(Section):
+    """A failure to count: an output below or above a limit (its probability gets a 95 % interval)."""
+
+    name: Annotated[str, Field(pattern=r"^[a-z][a-z0-9_]{0,63}$")]
+    label: Text
+    output: Annotated[str, Field(min_length=1, max_length=120)]
+    below: float | None = None
+    above: float | None = None
+
+    @model_validator(mode="after")
+    def _one_side(self) -> Failure:
+        if (self.below is None) == (self.above is None):
+            raise ParamError(f"failures[{self.name}]", "below/above", "exactly one of below or above")
+        return self
+
+    def failed(self, value: float) -> bool:
+        return value < self.below if self.below is not None else value > float(self.above)  # type: ignore[arg-type]
+
+
+class Paper(Section):
+    """A measured figure from the paper, shown beside the study's distribution of that output."""
+
+    output: Annotated[str, Field(min_length=1, max_length=120)]
+    value: float
+    label: Text
+
+
+class StudySpec(Section):
+    """The whole study file."""
+
+    title: Text
+    template: Annotated[str, Field(min_length=1, max_length=200)]
+    samples: Annotated[int, Field(ge=2, le=MAX_SAMPLES)]
+    seed: Annotated[int, Field(ge=0, le=2**63 - 1)]
+    sampler: Literal["sobol", "lhs", "random"] = "sobol"
+    # variants evaluated on the exact model (the first N of the sequence), -1: every variant
+    exact: Annotated[int, Field(ge=-1, le=MAX_EXACT)] = -1
+    # the K worst variants (by rank_by, ascending) re-checked with the full pipeline
+    check_worst: Annotated[int, Field(ge=0, le=MAX_CHECKS)] = 0
+    rank_by: Annotated[str, Field(min_length=1, max_length=120)]
+    inputs: Annotated[list[Input], Field(min_length=1, max_length=64)]
+    failures: Annotated[list[Failure], Field(max_length=32)] = []
+    paper: Annotated[list[Paper], Field(max_length=32)] = []
+
+    @model_validator(mode="after")
+    def _unique(self) -> StudySpec:
+        values = [i.field for i in self.inputs if i.mode == "value"]
+        for f in values:
+            if values.count(f) > 1:
+                raise ParamError("inputs.field", f, "a template field takes one value input (offsets may be added)")
+        keys = [i.key for i in self.inputs]
+        for k in keys:
+            if keys.count(k) > 1:
+                raise ParamError("inputs.name", k, "input names must be unique (name the offsets)")
+        names = [f.name for f in self.failures]
+        for n in names:
+            if names.count(n) > 1:
+                raise ParamError("failures.name", n, "failure names must be unique")
+        return self
+
+
+def load_spec(path: str | Path) -> StudySpec:
+    """Read and validate a study file (one-line :class:`ParamError` on bad input)."""
+    path = Path(path)
+    data = read_toml(path)
+    return validate(StudySpec, data, str(path))  # type: ignore[return-value]
+
+
+def template_path(spec: StudySpec, study_file: Path | None) -> Path:
+    """The study's template: beside the study file, else among the shipped templates."""
+    from gearcheck.design import packaged_templates
+
+    candidates = []
+    if study_file is not None:
+        candidates.append(Path(study_file).parent / spec.template)
+    candidates += [Path("templates") / spec.template, packaged_templates() / spec.template]
+    for c in candidates:
+        if c.is_file():
+            return c
+    raise ParamError("template", spec.template, "no such template beside the study file, in ./templates or shipped "
+                     "with gearcheck (see `gearcheck templates`)", str(study_file or "<study>"))
+
+
+def packaged_studies() -> Path:
+    """The folder of the study files shipped in the package (beside the templates)."""
+    from gearcheck.design import packaged_templates
+
+    return packaged_templates() / "studies"
+
+
+def find_study(name: str | Path) -> Path:
+    """A study file path, or the name (with or without .toml) of a shipped study."""
+    path = Path(name)
+    if path.is_file():
+        return path
+    stem = path.name.removesuffix(".toml")
+    shipped = packaged_studies() / f"{stem}.toml"
+    if path.parent == Path(".") and shipped.is_file():
+        return shipped
+    known = ", ".join(sorted(p.stem for p in packaged_studies().glob("*.toml")))
+    raise ParamError("study", str(name), f"no such file; shipped studies: {known}")
