@@ -131,7 +131,7 @@ def main() -> int:
     for name, fig in st["analytical_batch"].items():
         print(f"study {name}: analytical, {fig['variants']} variants in {fig['seconds']:.2f} s on one core")
     for name, fig in st["exact_level"].items():
-        print(f"study {name}: exact level {fig['variants_per_s_per_core']:.2f} variants/s per core")
+        print(f"study {name}: {fig['level']} level {fig['variants_per_s_per_core']:.2f} variants/s per core")
     d = st["dask_vs_local"]
     print(f"study {d['study']}: Dask LocalCluster {d['dask_s']:.1f} s vs local {d['local_s']:.1f} s "
           f"({d['workers']} workers), rows identical: {d['rows_identical']}")

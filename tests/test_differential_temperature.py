@@ -326,3 +326,17 @@ def test_calc_shows_the_exact_range_beside_the_linear_model(template, grid):
     assert figs["design_thinning_min_um"].value == pytest.approx(th.min_mm * 1e3)
     assert figs["paper_model_thinning_min_um"].value == pytest.approx(template.backlash.mesh_thinning_min_mm * 1e3)
     assert all(math.isfinite(f.value) for f in figs.values())
+
+
+def test_a_shim_that_is_not_a_round_figure_keeps_its_key():
+    """A study draws shims such as 0.09894159820366788 mm: the sweep's shim list keeps the
+    template's shim exactly (its key in every table), a repeat of it is dropped, others are
+    rounded to 1e-9 mm. Before, the rounded list lost the template's key (KeyError in the plan)."""
+    from types import SimpleNamespace
+
+    from gearcheck.mechanisms.differential.sweep import _shims
+
+    odd = 0.09894159820366788
+    shims = _shims(SimpleNamespace(template_shim_mm=odd, study_shims_mm=[0.0, 0.05, 0.1]), None)
+    assert odd in shims and shims.index(odd) == 2 and shims == sorted(shims)
+    assert _shims(SimpleNamespace(template_shim_mm=0.1, study_shims_mm=[0.1 + 1e-12, 0.05]), None) == [0.0, 0.05, 0.1]

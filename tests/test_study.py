@@ -188,3 +188,22 @@ def test_differential_exact_row_reproduces_the_calibration_and_binds_in_storage_
     paper = d.impl.study_row(d.params, "analytical")
     assert paper["warm_play_arcmin"] == pytest.approx(8.4)
     assert paper["least_play_storage_arcmin"] > 0  # the linear model misses the storage binding
+
+
+@pytest.mark.cad
+def test_zero_width_study_checks_exactly_what_check_checks(tmp_path):
+    """Level 3 on a zero-width variant (every input at its template value) writes the same
+    summary.json, byte for byte, as `gearcheck check` of the template; its folder is linked."""
+    path = write(tmp_path, samples=2, exact=-1, dist="uniform", shape="low = 4.1\nhigh = 4.1")
+    path.write_text(path.read_text().replace("low = 0.0\nhigh = 3.0", "low = 1.5\nhigh = 1.5")
+                    .replace("check_worst = 0", "check_worst = 1"))
+    res = gearcheck.study(path, jobs=1, out=tmp_path / "study")
+    (check,) = res.summary["checks"]
+    assert check["level"] == "pass" and check["folder"] == f"checks/variant_{check['variant']:05d}"
+    variant = tmp_path / "study" / check["folder"]
+    assert main(["check", "templates/eod_track_drive.toml", "--jobs", "1", "--out", str(tmp_path / "direct")]) == 0
+    assert (variant / "summary.json").read_bytes() == (tmp_path / "direct" / "summary.json").read_bytes()
+    page = (tmp_path / "study" / "report.html").read_text()
+    assert f"href='{check['folder']}/report.html'" in page
+    t = res.table.to_pydict()
+    assert t["check.level"][check["variant"]] == "pass"

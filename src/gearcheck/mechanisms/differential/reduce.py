@@ -185,7 +185,7 @@ def _arrays(setup: SweepSetup, by_key: dict, ranges: dict[int, RangeCheck]) -> S
         index.setdefault(name, int(np.argmin([abs(temp - tt) for _, tt in setup.states])))
     return SweepData(
         specs=setup.layout.specs, shims=shims, template_shim_mm=template_shim,
-        t=shims.index(round(template_shim, 9)), z=shims.index(0.0) if 0.0 in shims else None,
+        t=shims.index(template_shim), z=shims.index(0.0) if 0.0 in shims else None,
         states=list(setup.states), index=index, measured=measured,
         angles=angles, period_rad=setup.period_rad, geom_plus=geom_plus, geom_minus=geom_minus,
         exact_plus=exact_plus, exact_minus=exact_minus, centred_free=centred_free,

@@ -222,7 +222,13 @@ class SweepSetup:
 def _shims(layout: Layout, shims_mm) -> list[float]:
     if shims_mm is None:
         shims_mm = list(layout.study_shims_mm) + [0.0]
-    return sorted({round(float(s), 9) for s in list(shims_mm) + [layout.template_shim_mm]})
+    # the template's shim exactly as given (its key in every table); others rounded to 1e-9 mm and
+    # dropped where they repeat it (a study's shim need not be a round figure)
+    out = [float(layout.template_shim_mm)]
+    for s in sorted(round(float(x), 9) for x in shims_mm):
+        if all(not math.isclose(s, o, abs_tol=1e-9) for o in out):
+            out.append(s)
+    return sorted(out)
 
 
 def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
