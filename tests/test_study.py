@@ -207,3 +207,13 @@ def test_zero_width_study_checks_exactly_what_check_checks(tmp_path):
     assert f"href='{check['folder']}/report.html'" in page
     t = res.table.to_pydict()
     assert t["check.level"][check["variant"]] == "pass"
+
+
+def test_templates_lists_the_shipped_studies_and_study_runs_one_by_name(capsys, tmp_path):
+    assert main(["templates"]) == 0
+    out = capsys.readouterr().out
+    for name in ("differential_tolerances", "track_wear", "steering_tolerances"):
+        assert name in out
+    assert main(["study", "no_such_study", "--out", str(tmp_path / "x")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "no_such_study" in err[0] and "track_wear" in err[0]

@@ -65,6 +65,19 @@ def _scatter(n: int, indices: np.ndarray, cols: dict[str, np.ndarray]) -> dict[s
     return out
 
 
+def shown(path: Path) -> str:
+    """A path as a reader can follow it: a shipped file by where it sits in the package, another
+    relative to the working folder when inside it, else as it is."""
+    from gearcheck.design import packaged_templates
+
+    p = Path(path).absolute()
+    with contextlib.suppress(ValueError):
+        return f"gearcheck/templates/{p.relative_to(packaged_templates().absolute())} (shipped)"
+    with contextlib.suppress(ValueError):
+        return str(p.relative_to(Path.cwd()))
+    return str(path)
+
+
 def evaluate(spec: StudySpec, base: Base, inputs: dict[str, np.ndarray], executor: Any,
              progress: ProgressFactory = no_progress, exact: int | None = None) -> dict[str, Any]:
     """Levels 1 and 2 over the variants (``inputs``: the template fields each sets): validity,
@@ -251,7 +264,7 @@ def study(path: str | Path, *, samples: int | None = None, seed: int | None = No
         checks = run_checks(base, fields, picks, folder, jobs if not scheduler else None, progress)
         timings = {**ev["timings"], "check_s": time.perf_counter() - t1, "total_s": time.perf_counter() - t0,
                    "workers": getattr(executor, "jobs", 1)}
-        summary = summarise(spec, str(tpl), inputs, ev, checks, n, s)
+        summary = summarise(spec, shown(tpl), inputs, ev, checks, n, s)
         tab = table(inputs, fields, ev, checks)
         result = StudyResult(spec, tab, summary, folder, timings)
         if folder is not None:
@@ -265,11 +278,11 @@ def study(path: str | Path, *, samples: int | None = None, seed: int | None = No
             pq.write_table(tab, sink, compression="zstd")
             atomic_write_bytes(folder / "results.parquet", sink.getvalue().to_pybytes())
             atomic_write_text(folder / "summary.json", _json(summary))
-            atomic_write_text(folder / "report.html", render(spec, summary, tab, study_file=str(path)))
+            atomic_write_text(folder / "report.html", render(spec, summary, tab, study_file=shown(path)))
             from gearcheck.pipeline import seal
 
-            seal(folder, {"gearcheck_version": __version__, "kind": "study", "study": str(path),
-                                "template": str(tpl), "samples": n, "seed": s}, Path(out))  # type: ignore[arg-type]
+            seal(folder, {"gearcheck_version": __version__, "kind": "study", "study": shown(path),
+                                "template": shown(tpl), "samples": n, "seed": s}, Path(out))  # type: ignore[arg-type]
         return result
 
     if out is None:
