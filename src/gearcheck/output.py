@@ -24,6 +24,7 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
+from collections.abc import Callable
 from types import TracebackType
 
 from gearcheck.params import ParamError
@@ -115,9 +116,11 @@ def temp_path_beside(path: Path) -> Path:
     return Path(tmp)
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file and a rename; an OSError becomes one
-    :class:`OutputError` line, and no temporary file is left."""
+def replace_atomically(path: Path, data: bytes, check: Callable[[Path], None] | None = None) -> None:
+    """Write ``data`` to a temporary file beside ``path``, fsync it, let ``check`` read it (it
+    raises to refuse it), then rename it over ``path``. Errors propagate as raised; no temporary
+    file is left whatever fails. The one atomic write: :func:`atomic_write_bytes` and the STEP
+    writer turn its errors into their own one-line errors."""
     path = Path(path)
     tmp: Path | None = None
     try:
@@ -126,13 +129,23 @@ def atomic_write_bytes(path: Path, data: bytes) -> None:
             fh.write(data)
             fh.flush()
             os.fsync(fh.fileno())
+        if check is not None:
+            check(tmp)
         os.replace(tmp, path)
-    except OSError as exc:
-        raise output_error(exc, path) from None
+        tmp = None
     finally:
-        if tmp is not None and tmp.exists():
+        if tmp is not None:
             with contextlib.suppress(OSError):
                 tmp.unlink()
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file and a rename; an OSError becomes one
+    :class:`OutputError` line, and no temporary file is left."""
+    try:
+        replace_atomically(path, data)
+    except OSError as exc:
+        raise output_error(exc, path) from None
 
 
 def atomic_write_text(path: Path, text: str) -> None:

@@ -60,7 +60,7 @@ from OCP.XSControl import XSControl_WorkSession
 
 from gearcheck import __version__
 from gearcheck.cad.placement import Part, location
-from gearcheck.output import temp_path_beside
+from gearcheck.output import replace_atomically
 from gearcheck.params import ParamError
 
 log = logging.getLogger("gearcheck")
@@ -446,22 +446,11 @@ def write_step(parts: Sequence[Part], path: Path, assembly_name: str) -> int:
     if assembly_name in names or len(set(names)) != len(names):
         raise ValueError(f"STEP product names must be unique: {assembly_name!r} and {names}")
     data = step_bytes(parts, assembly_name, path)
-    tmp: Path | None = None
     try:
-        tmp = temp_path_beside(path)
-        with open(tmp, "wb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
-        verify_step_file(tmp, parts, assembly_name, len(data), shown=path)
-        os.replace(tmp, path)
-        tmp = None
+        replace_atomically(path, data, check=lambda tmp: verify_step_file(tmp, parts, assembly_name, len(data),
+                                                                         shown=path))
     except StepWriteError:
         raise
     except OSError as exc:  # EFBIG under ulimit -f, ENOSPC, EACCES…
         raise StepWriteError(path, exc.strerror or str(exc), exc.errno) from exc
-    finally:
-        if tmp is not None:
-            with contextlib.suppress(OSError):
-                tmp.unlink()
     return len(data)
