@@ -207,8 +207,7 @@ class SpurPair(Mechanism):
             scene.set_poses({"gear_1": pose_1, "gear_2": pose_2})
             wp = WorstPose("least play, centred", "gear_1", "gear_2", pose_1.tolist(), pose_2.tolist(),
                            scene.distance("gear_1", "gear_2").distance)
-            return SweepOutcome(summary, [wp], Clearance(s["normal_mm"] / 2, "normal backlash per side"),
-                                data={"angles": angles, "play": play})
+            return SweepOutcome(summary, [wp], data={"angles": angles, "play": play})
 
         return SweepPlan(bodies_meshes(bodies), tasks, reduce, unit="phase")
 

@@ -241,17 +241,6 @@ def test_smallest_clearance_is_the_least_exact_play_by_magnitude(templates_dir, 
     assert "cold design point" in c.label and "overlap" not in c.label
 
 
-def test_the_sweep_reads_the_same_smallest_clearance(template):
-    # reduce's rule on the sweep's own exact cycle minima gives the pre-mesh hook's clearance
-    from gearcheck.mechanisms.differential.reduce import smallest_clearance
-
-    states = tp.meshed_states(template)
-    least = tp.exact_plays(template, template.shim.thickness_mm, [t for _, t in states]).least_arcmin
-    ours = smallest_clearance(gear_specs(template), template.shim.thickness_mm, least, states)
-    hook = DIFFERENTIAL.smallest_clearance(template)
-    assert ours.value_mm == pytest.approx(hook.value_mm, rel=1e-12) and ours.label == hook.label
-
-
 # -- verdicts on a hand-made sweep: the exact model decides when the mesh cannot resolve ---------
 def _sweep(params, geom_offset: float):
     """A sweep outcome whose mesh plays are the exact ones shifted by ``geom_offset`` (arcmin)."""

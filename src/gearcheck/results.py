@@ -162,13 +162,13 @@ class Confirmation:
 @dataclass
 class SweepOutcome:
     """What a mechanism's sweep reduced to, before verdicts: the figures (summary.json's
-    section, plain numbers), the poses to confirm exactly, the smallest clearance decided on,
-    wall-clock figures (never in summary.json) and anything the mechanism's verdicts and
-    report need (``data``, mechanism-specific)."""
+    section, plain numbers), the poses to confirm exactly, wall-clock figures (never in
+    summary.json) and anything the mechanism's verdicts and report need (``data``,
+    mechanism-specific). The smallest clearance to resolve comes before meshing, from
+    :meth:`gearcheck.mechanism.Mechanism.smallest_clearance`."""
 
     summary: dict
     worst_poses: list[WorstPose] = field(default_factory=list)
-    smallest_clearance: Clearance | None = None
     timings: dict = field(default_factory=dict)
     data: Any = None
     # set by the pipeline before the verdicts: False when the meshes' pair bound exceeds 1/10 of

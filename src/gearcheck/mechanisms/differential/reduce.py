@@ -19,10 +19,10 @@ from gearcheck.mechanisms.differential.analysis import PerSide, analyse_params, 
 from gearcheck.mechanisms.differential.params import shim_key
 from gearcheck.mechanisms.differential.poses import GearSpecs
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup
-from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, clearance,
-                                                           merge_plays, range_check)
+from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, merge_plays,
+                                                           range_check)
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
-from gearcheck.results import Clearance, SweepOutcome, WorstPose
+from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.engine import Scene
 
 # Mesh vs exact: within the mesh-error bound (as an angle on d1/2) plus this fraction.
@@ -132,10 +132,8 @@ def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
     data = _arrays(setup, by_key, ranges)
     summary = _summary(setup, data, by_key)
     worst = _worst_poses(setup, data, by_key)
-    t = data.t
-    outcome_clearance = smallest_clearance(data.specs, data.shims[t], data.exact_min[t], data.states)
     range_s = sum(results[task]["exact_s"] for _, task in setup.range_tasks)
-    return SweepOutcome(summary, worst, outcome_clearance, _timings(setup, by_key, wall_s, range_s, onset_s), data)
+    return SweepOutcome(summary, worst, _timings(setup, by_key, wall_s, range_s, onset_s), data)
 
 
 def _ranges(setup: SweepSetup, results: list[dict]) -> dict[int, RangeCheck]:
@@ -335,15 +333,6 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
         out.append(WorstPose(label, big, small, tb.cold_pose_about_origin(big_pose).tolist(),
                              ts.cold_pose_about_origin(poses[small]).tolist(), float(distance), tb.scale, ts.scale))
     return out
-
-
-def smallest_clearance(specs: GearSpecs, shim_mm: float, plays_arcmin, states: list[tuple[str, float]]
-                       ) -> Clearance | None:
-    """The least play per side (exact flanks) nearest zero but not zero at the template's shim over
-    the meshed states — an overlap counts by its depth — as the arc it spans on d1/2: the same
-    rule as :meth:`.mechanism.Differential.smallest_clearance`, on the sweep's own exact solves."""
-    plays = {name: float(v) for (name, _), v in zip(states, plays_arcmin, strict=True) if math.isfinite(v)}
-    return clearance(specs, shim_mm, plays, dict(states))
 
 
 def _timings(setup: SweepSetup, by_key: dict, wall_s: float, range_s: float, onset_s: float) -> dict:

@@ -462,4 +462,4 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
                          summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius))
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}
-    return SweepOutcome(summary, worst_poses, None, timings, data)
+    return SweepOutcome(summary, worst_poses, timings, data)

@@ -39,7 +39,7 @@ from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
 from gearcheck.mechanisms.track import wear as track_wear
 from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
-from gearcheck.mechanisms.track.clearance import (CYCLE_MARGIN_FRACTION, STEPS_PER_CYCLE, clearance_of, exact_section,
+from gearcheck.mechanisms.track.clearance import (CYCLE_MARGIN_FRACTION, STEPS_PER_CYCLE, exact_section,
                                                   sweep_angles, worn_model)
 from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
@@ -376,8 +376,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     n_poses = len(angles)
     timings = {"sweep_s": sweep_s, "poses_per_s": n_poses / sweep_s,
                "link_poses_per_s": n_poses * wrap.links / sweep_s, "contact_proof_s": proof_s}
-    clearance = clearance_of(x["ex_min_sleeve"].value, x["ex_min_plate"].value)
-    return SweepOutcome(summary(data), worst, clearance, timings, data)
+    return SweepOutcome(summary(data), worst, timings, data)
 
 
 def summary(d: TrackSweep) -> dict:
