@@ -164,6 +164,7 @@ def test_solved_thinning_reproduces_the_measurement(template):
     th = template.thinning()
     c = template.calibration
     assert th.calibrated and th.min_mm > th.template_min_mm
+    assert th.exact_evaluations == 3  # whole cycles: the template's thinning, the least, the largest
     for thinning, measured in ((th.min_mm, c.measured_backlash_total_min_arcmin),
                                (th.max_mm, c.measured_backlash_total_max_arcmin)):
         total = exact_warm_total(template, thinning, c.measured_shim_mm, c.measured_at_C)

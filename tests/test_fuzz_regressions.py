@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from gearcheck.geometry import bevel_contact as bc
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.mechanism import get as mechanism
 from gearcheck.mechanisms.differential.poses import gear_specs
@@ -73,7 +74,7 @@ def test_long_contact_path_widens_the_exact_play_window(monkeypatch):
     angles = np.linspace(0.0, specs.small.angular_pitch_rad, 4, endpoint=False)
     cycle = bp.pair_play_over_cycle(specs.big, specs.small, angles)
     # the same play with far more teeth sampled: the window misses no tooth that touches first
-    monkeypatch.setattr(bp, "MIN_TEETH_WINDOW", 6)
+    monkeypatch.setattr(bc, "MIN_TEETH_WINDOW", 6)
     wide = bp.pair_play_over_cycle(specs.big, specs.small, angles)
     assert np.allclose(cycle.plus_rad, wide.plus_rad, atol=1e-12)
     assert np.allclose(cycle.minus_rad, wide.minus_rad, atol=1e-12)

@@ -184,6 +184,11 @@ def test_differential_exact_row_reproduces_the_calibration_and_binds_in_storage_
     d = gearcheck.load("templates/zhurong_differential.toml")
     row = d.impl.study_row(d.params, "exact")
     assert 2 * row["warm_play_arcmin"] == pytest.approx(16.8, abs=1e-3)  # solved to reproduce it
+    # the warm play is the calibration's own last solve (not evaluated twice): the exact model's figure
+    from gearcheck.mechanisms.differential import temperature as tp
+    op = d.params.operating
+    independent = tp.exact_plays(d.params, d.params.shim.thickness_mm, [op.warm_C, op.cold_C]).least_arcmin
+    assert (row["warm_play_arcmin"], row["cold_play_arcmin"]) == (independent[0], independent[1])
     assert row["least_play_operating_arcmin"] > 0 > row["least_play_storage_arcmin"]
     paper = d.impl.study_row(d.params, "analytical")
     assert paper["warm_play_arcmin"] == pytest.approx(8.4)

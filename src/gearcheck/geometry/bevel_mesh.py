@@ -37,6 +37,15 @@ def drive_poses(built: Mapping[str, np.ndarray], bigs: Sequence[str], smalls: Se
     return out
 
 
+def rigid_inverse(pose: np.ndarray) -> np.ndarray:
+    """The inverse of a rigid 4×4 transform (rotation and translation): Rᵀ, −Rᵀ·t."""
+    out = np.eye(4)
+    rt = pose[:3, :3].T
+    out[:3, :3] = rt
+    out[:3, 3] = -rt @ pose[:3, 3]
+    return out
+
+
 def congruent(q1: np.ndarray, q2: np.ndarray, big: BevelGearSpec, small: BevelGearSpec, tol: float = 1e-9) -> bool:
     """Two big/small pairs, given as small-frame → big-frame transforms, are the same mesh when
     q2 = Rz(k·pitch_big)·q1·Rz(j·pitch_small) for whole k, j (identical teeth relabelled)."""
@@ -45,8 +54,9 @@ def congruent(q1: np.ndarray, q2: np.ndarray, big: BevelGearSpec, small: BevelGe
     k = (a2 - a1) / big.angular_pitch_rad
     if abs(k - round(k)) > tol:
         return False
-    m = np.linalg.inv(rot_z4(round(k) * big.angular_pitch_rad) @ q1) @ q2
-    if not (np.allclose(m[:3, 2], [0.0, 0.0, 1.0], atol=tol) and np.allclose(m[:3, 3], 0.0, atol=tol)):
+    m = rigid_inverse(rot_z4(round(k) * big.angular_pitch_rad) @ q1) @ q2
+    if not (abs(m[0, 2]) <= tol and abs(m[1, 2]) <= tol and abs(m[2, 2] - 1.0) <= tol
+            and abs(m[0, 3]) <= tol and abs(m[1, 3]) <= tol and abs(m[2, 3]) <= tol):
         return False
     j = math.atan2(m[1, 0], m[0, 0]) / small.angular_pitch_rad
     return abs(j - round(j)) <= tol

@@ -16,14 +16,18 @@ value gives the least thinning (the gears are built with it), the largest the la
 
 The exact warm total grows with the thinning at very nearly 2/(d1/2) rad per mm (a thinning is a
 turn of each flank about its own axis, exact for the big gear's flanks and first order for the
-small gear's), so a secant solve from the template's thinning converges in two or three exact
-evaluations; it stops at :data:`SOLVE_TOL_ARCMIN`.
+small gear's) and is linear in it to about 1e-5 of that slope, so a Newton step from the template's thinning
+(solved at the least-play pose only) gives the slope, a step on it over the whole cycle reaches
+the least measured value, and one more over the whole cycle the largest: three whole-cycle exact
+evaluations and one of a single pose; each stops at :data:`SOLVE_TOL_ARCMIN`.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+
+import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.mechanisms.differential import temperature
@@ -77,48 +81,80 @@ def exact_warm_total(params, thinning_mm: float, shim_mm: float, at_C: float) ->
 
 
 class _Totals:
-    """Exact warm totals at the measured shim and temperature, by thinning (each solved once)."""
+    """Exact warm totals at the measured shim and temperature, by thinning (each solved once), and
+    the drive angle of the least play of the last whole cycle solved."""
 
     def __init__(self, params, shim_mm: float, at_C: float):
         self.params, self.shim_mm, self.at_C = params, shim_mm, at_C
         self.known: dict[float, float] = {}
+        self.least_angle: float | None = None
+
+    def _plays(self, thinning_mm: float, which: str, angles: list[float] | None = None):
+        try:
+            return temperature.exact_plays(self.params, self.shim_mm, [self.at_C], angles_rad=angles,
+                                           specs=gear_specs(self.params, thinning_mm=thinning_mm))
+        except RuntimeError as exc:  # the exact model finds no contact (play beyond its reach)
+            raise CalibrationError(which, f"the exact model cannot measure this backlash ({exc})") from None
+        except ValueError as exc:  # the gears cannot be made with this thinning (pointed teeth)
+            raise CalibrationError(which, f"no gear pair with {thinning_mm:.4f} mm of tooth thinning ({exc})"
+                                   ) from None
 
     def __call__(self, thinning_mm: float, which: str) -> float:
+        """The total over the whole cycle (both sides: twice the least play per side)."""
         if thinning_mm not in self.known:
-            try:
-                self.known[thinning_mm] = exact_warm_total(self.params, thinning_mm, self.shim_mm, self.at_C)
-            except RuntimeError as exc:  # the exact model finds no contact (play beyond its reach)
-                raise CalibrationError(which, f"the exact model cannot measure this backlash ({exc})") from None
-            except ValueError as exc:  # the gears cannot be made with this thinning (pointed teeth)
-                raise CalibrationError(which, f"no gear pair with {thinning_mm:.4f} mm of tooth thinning ({exc})"
-                                       ) from None
+            plays = self._plays(thinning_mm, which)
+            play = plays.play_arcmin[0]  # (angle, big gear)
+            self.least_angle = float(plays.angles_rad[np.unravel_index(np.argmin(play), play.shape)[0]])
+            self.known[thinning_mm] = 2.0 * float(plays.least_arcmin[0])
         return self.known[thinning_mm]
 
+    def at_least_angle(self, thinning_mm: float, which: str) -> float:
+        """The total at the drive angle of the last cycle's least play only: a step of the solve,
+        never its result (a thinning moves every pose's play alike, so the least stays there; the
+        result is always a whole cycle)."""
+        assert self.least_angle is not None
+        return 2.0 * float(self._plays(thinning_mm, which, [self.least_angle]).least_arcmin[0])
 
-def _solve(params, totals: _Totals, target: float, which: str, start_mm: float) -> tuple[float, float]:
-    """The thinning whose exact warm total is ``target``: (thinning, its total)."""
+
+def _solve(params, totals: _Totals, target: float, which: str, start_mm: float,
+           slope: float | None = None) -> tuple[float, float, float]:
+    """The thinning whose exact warm total is ``target``: (thinning, its total, the last secant
+    slope). The total is linear in the thinning to about 1e-5 of its slope (a thinning turns each
+    flank about its own axis). Without a ``slope``: a Newton step from ``start_mm`` on the
+    first-order slope, taken at the least-play pose only, gives the slope; then secant steps over
+    whole cycles (one or two). With one: secant steps from ``start_mm`` (usually one)."""
     d1_half = params.gears.module_mm * params.gears.big_teeth / 2.0
-    slope = 2.0 * bp.ARCMIN_PER_RAD / d1_half  # arcmin of total per mm of thinning, to first order
-    zero = totals(0.0, which)
-    if target < zero:
-        raise CalibrationError(which, f"the exact geometry with no tooth thinning already has {zero:.3f}′ at shim "
-                               f"{totals.shim_mm:g} mm, {totals.at_C:g} °C (cycle minimum, both sides)", zero, "lower")
-    t0, f0 = 0.0, zero - target
-    t1 = min(max(start_mm, 0.0), THINNING_MAX_MM)
-    if t1 == t0:
-        t1 = -f0 / slope
-    f1 = math.nan
+    first_order = 2.0 * bp.ARCMIN_PER_RAD / d1_half  # arcmin of total per mm of thinning
+    s = first_order if slope is None or not slope > 0 else slope
+    t0 = min(max(start_mm, 0.0), THINNING_MAX_MM)
+    f0 = totals(t0, which) - target
+    if abs(f0) <= SOLVE_TOL_ARCMIN:
+        return t0, f0 + target, s
+    t1 = t0 - f0 / s
+    if slope is None and 0.0 < t1 <= THINNING_MAX_MM:
+        g1 = totals.at_least_angle(t1, which) - target
+        s = (g1 - f0) / (t1 - t0) if (g1 - f0) / (t1 - t0) > 0 else first_order
+        t0, f0 = t1, g1
     for _ in range(SOLVE_ITERATIONS):
+        t1 = t0 - f0 / s
+        if t1 < 0.0:  # below no thinning: the target may be out of reach
+            zero = totals(0.0, which)
+            if target < zero:
+                raise CalibrationError(which, f"the exact geometry with no tooth thinning already has {zero:.3f}′ at "
+                                       f"shim {totals.shim_mm:g} mm, {totals.at_C:g} °C (cycle minimum, both sides)",
+                                       zero, "lower")
+            t1 = 0.0
         if t1 > THINNING_MAX_MM:
             top = totals(THINNING_MAX_MM, which)
             raise CalibrationError(which, f"it needs more than {THINNING_MAX_MM} mm of tooth thinning (the exact "
                                    f"total at {THINNING_MAX_MM} mm is {top:.3f}′)", top, "upper")
         f1 = totals(t1, which) - target
         if abs(f1) <= SOLVE_TOL_ARCMIN:
-            return t1, f1 + target
-        s = (f1 - f0) / (t1 - t0) if t1 != t0 else slope
-        t0, f0, t1 = t1, f1, max(t1 - f1 / (s if s > 0 else slope), 0.0)
-    raise CalibrationError(which, f"the thinning solve did not converge (last {t1:.5f} mm, off by {f1:.2e}′)")
+            return t1, f1 + target, s
+        secant = (f1 - f0) / (t1 - t0) if t1 != t0 else 0.0
+        s = secant if secant > 0 else first_order
+        t0, f0 = t1, f1
+    raise CalibrationError(which, f"the thinning solve did not converge (last {t0:.5f} mm, off by {f0:.2e}′)")
 
 
 def calibrated_thinning(params) -> Thinning:
@@ -129,9 +165,9 @@ def calibrated_thinning(params) -> Thinning:
     if not c.given:
         return base
     totals = _Totals(params, c.measured_shim_mm, c.measured_at_C)
-    t_min, total_min = _solve(params, totals, c.measured_backlash_total_min_arcmin, "min", base.template_min_mm)
-    t_max, total_max = _solve(params, totals, c.measured_backlash_total_max_arcmin, "max",
-                              t_min + (base.template_max_mm - base.template_min_mm))
+    t_min, total_min, slope = _solve(params, totals, c.measured_backlash_total_min_arcmin, "min",
+                                     base.template_min_mm)
+    t_max, total_max, _ = _solve(params, totals, c.measured_backlash_total_max_arcmin, "max", t_min, slope)
     template_total = totals(base.template_min_mm, "min")
     return Thinning(t_min, t_max, base.template_min_mm, base.template_max_mm, True, total_min, total_max,
                     template_total, len(totals.known))

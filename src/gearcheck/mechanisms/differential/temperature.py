@@ -31,7 +31,7 @@ import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel import BevelGearSpec
-from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period
+from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period, rigid_inverse
 from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
 
@@ -113,12 +113,13 @@ def congruent_groups(placed: Mapping[str, bp.PlacedGear], big_spec: BevelGearSpe
     reuses that solve. Returns the groups (big, small, members) and how many pairs joined an
     earlier group."""
     groups: list[tuple[str, str, list[tuple[str, str]]]] = []
+    relative: list[np.ndarray] = []  # each group's small frame → big frame
     reused = 0
+    inverse = {big: rigid_inverse(placed[big].pose) for big in bigs}
     for big in bigs:
         for small in smalls:
-            q = np.linalg.inv(placed[big].pose) @ placed[small].pose
-            for g in groups:
-                gq = np.linalg.inv(placed[g[0]].pose) @ placed[g[1]].pose
+            q = inverse[big] @ placed[small].pose
+            for g, gq in zip(groups, relative, strict=True):
                 same_scales = placed[g[0]].scale == placed[big].scale and placed[g[1]].scale == placed[small].scale
                 if same_scales and congruent(gq, q, big_spec, small_spec, tol=1e-7):
                     g[2].append((big, small))
@@ -126,6 +127,7 @@ def congruent_groups(placed: Mapping[str, bp.PlacedGear], big_spec: BevelGearSpe
                     break
             else:
                 groups.append((big, small, [(big, small)]))
+                relative.append(q)
     return groups, reused
 
 
@@ -209,13 +211,17 @@ class ExactPlays:
 
 
 def exact_plays(params, shim_mm: float, temperatures_C, *, specs: GearSpecs | None = None,
-                angles_per_cycle: int = ANGLES_PER_CYCLE, spots: bool = False) -> ExactPlays:
+                angles_per_cycle: int = ANGLES_PER_CYCLE, spots: bool = False,
+                angles_rad: Sequence[float] | None = None) -> ExactPlays:
     """The exact plays at ``shim_mm`` (the big gears moved out by it) at each temperature (°C),
-    over the cycle; ``spots``: also where the least-play pose's contacts lie."""
+    over the cycle (or at the drive angles ``angles_rad`` only); ``spots``: also where the
+    least-play pose's contacts lie."""
     specs = gear_specs(params) if specs is None else specs
     temps = np.atleast_1d(np.asarray(temperatures_C, dtype=float))
     built = assembly_poses(specs, shim_mm).as_dict()
     angles, period = cycle_angles(specs, shim_mm, angles_per_cycle)
+    if angles_rad is not None:
+        angles = np.asarray(angles_rad, float)
     solve_big: list[bp.PlacedGear] = []
     solve_small: list[bp.PlacedGear] = []
     owners: list[list[tuple[int, int, int, int]]] = []
@@ -231,7 +237,7 @@ def exact_plays(params, shim_mm: float, temperatures_C, *, specs: GearSpecs | No
                 solve_big.append(placed[big])
                 solve_small.append(placed[small])
                 owners.append([(i, k, BIG_GEARS.index(b), SMALL_GEARS.index(s)) for b, s in members])
-    contacts = {d: bp.big_gear_contacts(solve_big, solve_small, d) for d in DIRECTIONS}
+    contacts = dict(zip(DIRECTIONS, bp.big_gear_contacts_both(solve_big, solve_small), strict=True))
     shape = (len(temps), len(angles), len(BIG_GEARS), len(SMALL_GEARS))
     plus, minus, solved_by = np.empty(shape), np.empty(shape), np.empty(shape, dtype=int)
     for j, keys in enumerate(owners):
