@@ -15,10 +15,10 @@ STUDIES = Path(__file__).resolve().parents[1] / "src" / "gearcheck" / "templates
 BATCH_VARIANTS = 1_000_000
 EXACT_VARIANTS = {"track": 12, "differential": 8, "steering": 4}
 # The exact level on every core of this machine (local processes), this many variants, and the
-# time 10⁴ variants would then take: the issue asks for minutes on 2 cores (the bench holds it to
-# a quarter of an hour).
+# time 10⁴ variants would then take; the differential's must be minutes on 2 cores (the bench
+# holds it to a quarter of an hour).
 PARALLEL_VARIANTS = 96
-TARGET_1E4_S = 900.0
+TARGET_1E4_S = {"differential": 900.0}
 
 
 def _spec_and_base(path: Path):
@@ -73,8 +73,10 @@ def exact_rate(path: Path) -> dict[str, Any]:
         run_level(base, level, fields, np.arange(m), ProcessExecutor(jobs))
         wall = time.perf_counter() - t0
         out.update({"cores": jobs, "parallel_variants": m, "parallel_seconds": wall,
-                    "parallel_variants_per_s": m / wall, "projected_1e4_variants_s": 1e4 * wall / m,
-                    "target_1e4_s": TARGET_1E4_S, "meets_target": 1e4 * wall / m <= TARGET_1E4_S})
+                    "parallel_variants_per_s": m / wall, "projected_1e4_variants_s": 1e4 * wall / m})
+        target = TARGET_1E4_S.get(design.mechanism)
+        if target is not None:
+            out.update({"target_1e4_s": target, "meets_target": 1e4 * wall / m <= target})
     return out
 
 

@@ -29,3 +29,24 @@ def build_bodies(tmp_path_factory):
         return cache[key]
 
     return build
+
+
+@pytest.fixture(scope="session")
+def template_check(tmp_path_factory):
+    """Factory: ``gearcheck check`` of a template (with --set overrides) into a temp folder, on 2
+    processes; returns the :class:`gearcheck.pipeline.CheckRun`. Each distinct request runs once
+    per session, so every test module that reads a template's report shares one run."""
+    cache = {}
+
+    def check(name: str, overrides: tuple[str, ...] = ()):
+        key = (name, tuple(overrides))
+        if key not in cache:
+            from gearcheck import pipeline
+            from gearcheck.design import load_template
+
+            design = load_template(TEMPLATES / f"{name}.toml", list(overrides))
+            cache[key] = pipeline.check(design, tmp_path_factory.mktemp(f"check_{name}") / "run", jobs=2,
+                                        overrides=list(overrides))
+        return cache[key]
+
+    return check
