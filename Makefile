@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.gearcheck-installed
 
-.PHONY: install demo studies test lint bench fuzz clean
+.PHONY: install demo studies test browser lint bench fuzz clean
 
 install: $(STAMP)
 
@@ -18,11 +18,17 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(PY) -m gearcheck demo --out out
 
-# Lint and type-check first (seconds), then the suite.
-test: $(STAMP)
+# Lint and type-check first (seconds), then the suite. The browser test needs Debian's Chromium:
+# installed here when missing (apt-get, as root or through sudo), and required by the suite.
+test: $(STAMP) browser
 	$(VENV)/bin/ruff check src bench
 	$(VENV)/bin/mypy
-	$(PY) -m pytest -q
+	GEARCHECK_REQUIRE_BROWSER=1 $(PY) -m pytest -q --durations=12
+
+browser:
+	@command -v chromium >/dev/null 2>&1 || { \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium; }
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src bench

@@ -537,3 +537,17 @@ def test_printed_bounds_hold_on_random_track_sets(data):
 @given(data=st.data())
 def test_printed_bounds_hold_on_random_steering_sets(data):
     _random_bounds_hold("steering", data)
+
+
+def test_rows_filling_the_track_blame_the_tooth_width(templates_dir):
+    """Three rows of 10.03 mm in a 30.09 mm track fill it to a rounding: the grooves (which must
+    be > 0) have no bound left, so the rejection names the tooth width, and its bound holds."""
+    data = apply_overrides(read_toml(templates_dir / "eod_track_drive.toml"),
+                           ["sprocket.tooth_rows=3", "sprocket.tooth_width_mm=10.03", "chain.track_width_mm=30.09",
+                            "sprocket.middle_groove_width_mm=1e-9", "strength.loaded_tooth_rows=1"])
+    data.pop("mechanism", None)
+    model = mechanism("track").Params
+    with pytest.raises(ParamError) as info:
+        validate(model, data, "rows.toml")
+    assert info.value.field == "sprocket.tooth_width_mm", info.value
+    assert bounds_hold(model, data, info.value, "rows.toml") >= 1

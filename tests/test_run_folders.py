@@ -248,8 +248,10 @@ def test_templates_are_listed_and_copied(tmp_path, capsys):
     out = capsys.readouterr().out
     assert "zhurong_differential.toml" in out and "differential" in out
     assert main(["templates", "--copy", str(tmp_path / "mine")]) == 0
-    copied = sorted(p.name for p in (tmp_path / "mine").iterdir())
+    copied = sorted(p.name for p in (tmp_path / "mine").glob("*.toml"))
     assert copied == ["eod_track_drive.toml", "nose_wheel_steering.toml", "zhurong_differential.toml"]
+    assert sorted(p.name for p in (tmp_path / "mine" / "schema").iterdir()) == [
+        "differential.json", "steering.json", "track.json"]
     (tmp_path / "mine" / "eod_track_drive.toml").write_text("# my edits\n")
     assert main(["templates", "--copy", str(tmp_path / "mine")]) == 2  # never overwrites an edited copy
     assert (tmp_path / "mine" / "eod_track_drive.toml").read_text() == "# my edits\n"

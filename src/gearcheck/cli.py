@@ -2,8 +2,9 @@
 input (or an output that cannot be written), 130 / 143 interrupted by SIGINT / SIGTERM.
 
 The only module that prints. Everything it runs is the library's (:mod:`gearcheck.design`,
-:mod:`gearcheck.pipeline`); progress bars go to stderr when it is a terminal, diagnostics to the
-``gearcheck`` logger (``-v`` shows them).
+:mod:`gearcheck.pipeline`); what it shows is made by :mod:`gearcheck.terminal` (tables and
+coloured verdicts on a terminal, plain lines when piped, the JSON of ``--json``); progress bars go
+to stderr when it is a terminal, diagnostics to the ``gearcheck`` logger (``-v`` shows them).
 
 Interrupts: SIGINT and SIGTERM are caught from the first lines of this module on (its imports are
 the standard library's only; the rest is imported inside :func:`main`), so an interrupt at any
@@ -44,7 +45,6 @@ import contextlib  # noqa: E402
 import json  # noqa: E402
 import logging  # noqa: E402
 import os  # noqa: E402
-from collections.abc import Iterator  # noqa: E402
 from pathlib import Path  # noqa: E402
 from typing import TYPE_CHECKING, Any  # noqa: E402
 
@@ -52,50 +52,12 @@ from gearcheck import __version__  # noqa: E402
 
 if TYPE_CHECKING:
     from gearcheck.design import Design
-    from gearcheck.pipeline import Bar
-
-DESCRIPTION = """\
-gearcheck turns a parameter file (TOML template) into the design figures, CAD and an
-interference proof of a gear mechanism.
-
-Mechanisms: {mechanisms} (one template each in templates/:
-  zhurong_differential.toml   bevel-gear differential, cold backlash and shims
-  eod_track_drive.toml        roller-chain track sprocket, every other tooth engaging
-  nose_wheel_steering.toml    trimmed rack and pinion, continuous drive and disengage angles)
-
-Examples:
-  gearcheck calc templates/zhurong_differential.toml
-  gearcheck calc templates/zhurong_differential.toml --set operating.cold_C=-130
-  gearcheck calc templates/nose_wheel_steering.toml --set trim.min_contact_ratio=1.3 --json
-  gearcheck check templates/eod_track_drive.toml --jobs 2
-"""
-
-TOL_HELP = ("absolute chordal tolerance of the meshes in mm, used as given (default per mechanism: {defaults}, "
-            "refined before meshing so that the two meshes' error bounds together stay within 1/10 of the "
-            "smallest clearance the design asks to decide, from its exact model; where a mesh cannot resolve "
-            "it, the exact model and the exact B-rep decide, and the report says so)")
-
+    from gearcheck.pipeline import Bar, CheckRun
+    from gearcheck.terminal import Screen
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # usage errors are bad input: exit 2, one line
         self.exit(2, f"gearcheck: error: {message}\n")
-
-
-class _Formatter(argparse.HelpFormatter):
-    """Fills in the per-mechanism tolerances only when help is shown (it imports the mechanisms)."""
-
-    def _get_help_string(self, action: argparse.Action) -> str | None:
-        text = super()._get_help_string(action)
-        if action.dest == "tol" and text is not None:
-            from gearcheck.mechanism import all_mechanisms
-
-            defaults = ", ".join(f"{m.name} {m.mesh_tol_mm:g}" for m in all_mechanisms())
-            return text.replace("{defaults}", defaults)
-        return text
-
-
-class _MainFormatter(_Formatter, argparse.RawDescriptionHelpFormatter):
-    """The top-level help keeps its description's lines (the template list, the examples)."""
 
 
 def _jobs(text: str) -> int:
@@ -121,8 +83,14 @@ def _add_jobs_arg(p: argparse.ArgumentParser, what: str) -> None:
                         "Results are identical for any N.")
 
 
+def _add_open_arg(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--open", action="store_true", help=f"open {what} in the web browser when done")
+
+
 def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
-    """TEMPLATE | --all, --set, --out, --tol, --jobs: shared by `build` and `check`."""
+    """TEMPLATE | --all, --set, --out, --tol, --jobs, --json, --open: shared by `build` and `check`."""
+    from gearcheck.terminal import TOL_HELP
+
     p.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
     p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                    help="override one template value (repeatable)")
@@ -135,13 +103,20 @@ def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
                    help="output folder (default out/NAME; with --all, the parent folder, default out)")
     p.add_argument("--tol", type=float, default=None, metavar="MM", help=TOL_HELP)
     _add_jobs_arg(p, "the sweep" if verb == "check" else "building several templates (--all)")
+    what = ("the verdicts, the key figures (paper / model / geometry, exact confirmation)" if verb == "check"
+            else "the parts (material, triangles, volume)")
+    p.add_argument("--json", action="store_true",
+                   help=f"print one JSON object on stdout and nothing else: mechanism, name, folder, {what}, the "
+                        "mesh, and every file written with its size (with --all: {\"runs\": [...]})")
+    _add_open_arg(p, "report.html" if verb == "check" else "the output folder")
 
 
 def build_parser() -> argparse.ArgumentParser:
     from gearcheck.mechanism import names
+    from gearcheck.terminal import BUILD_EXAMPLES, CHECK_EXAMPLES, DESCRIPTION, HelpFormatter as _Formatter
 
     parser = _Parser(prog="gearcheck", description=DESCRIPTION.format(mechanisms=", ".join(names())),
-                     formatter_class=_MainFormatter)
+                     formatter_class=_Formatter)
     parser.add_argument("--version", action="version", version=f"gearcheck {__version__}")
     parser.add_argument("--verbose", "-v", action="store_true", help="print diagnostics (timings, workers) to stderr")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -152,13 +127,16 @@ def build_parser() -> argparse.ArgumentParser:
         description="Compute the mechanism's design figures from its template with the paper's "
         "analytical model (reconstructed where the paper lost equations), and print them beside "
         "the paper's printed values with the difference and the reason where they differ.",
+        epilog="Examples:\n  gearcheck calc templates/zhurong_differential.toml --set operating.cold_C=-130\n"
+               "  gearcheck calc templates/eod_track_drive.toml --json | jq .track.paper\n"
+               "  gearcheck calc templates/nose_wheel_steering.toml | less -S",
     )
     _add_template_args(calc)
     calc.add_argument("--json", action="store_true",
                       help="print one JSON object (nested by section) instead of a table")
 
     build = sub.add_parser(
-        "build", formatter_class=_Formatter,
+        "build", formatter_class=_Formatter, epilog=BUILD_EXAMPLES,
         help="build the CAD: STEP assembly, one STL per part, manifest.json",
         description="Build the mechanism's parts with CadQuery from the template (exact involute "
         "flanks), mesh each part with an absolute chordal tolerance, and write DIR/NAME.step "
@@ -169,7 +147,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cad_args(build, "build")
 
     check = sub.add_parser(
-        "check", formatter_class=_Formatter,
+        "check", formatter_class=_Formatter, epilog=CHECK_EXAMPLES,
         help="build, mesh and sweep the mechanism; write report.html, summary.json, sweep.csv",
         description="Build the CAD (as `build`), sweep the assembly through its motion with "
         "python-fcl on the meshes (warm and cold for the differential, a full engagement cycle "
@@ -183,12 +161,17 @@ def build_parser() -> argparse.ArgumentParser:
     _add_cad_args(check, "check")
 
     demo = sub.add_parser("demo", formatter_class=_Formatter,
-                          help="every template in templates/: figures and CAD under --out (what `make demo` runs)")
+                          help="every template in templates/: figures and CAD under --out (what `make demo` runs)",
+                          description="Check every template into OUT/NAME: the verdicts of each, and a pointer "
+                          "to its analytical figures (OUT/NAME/calc.txt and calc.json, as `gearcheck calc` prints "
+                          "them). Exit 1 if a verdict fails, after every template has run.",
+                          epilog="Examples:\n  gearcheck demo --open\n  gearcheck demo --no-cad --out /tmp/figures")
     demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
     demo.add_argument("--templates", type=Path, default=None, metavar="DIR",
                       help="folder of templates (default: ./templates/ if it holds any, else the shipped ones)")
     demo.add_argument("--no-cad", action="store_true", help="analytical figures only, no CAD build")
     _add_jobs_arg(demo, "the sweeps")
+    _add_open_arg(demo, "each report (the output folder with --no-cad)")
 
     study = sub.add_parser(
         "study", formatter_class=_Formatter,
@@ -197,9 +180,10 @@ def build_parser() -> argparse.ArgumentParser:
         "(seeded Sobol/LHS sequence, reproducible row for row), evaluate every variant on the analytical "
         "model and the exact model (numpy, no mesh), re-check the worst with the full pipeline (CAD, "
         "meshes, sweep, exact B-rep), and write DIR/results.parquet (one row per variant), DIR/summary.json "
-        "(distributions, each failure's probability with a 95 %% Wilson interval, sensitivities) and "
+        "(distributions, each failure's probability with a 95 % Wilson interval, sensitivities) and "
         "DIR/report.html — one transaction, like `check`. Shipped studies: `gearcheck templates` lists them; "
-        "pass a file name or its stem.\n\nExamples:\n  gearcheck study differential_tolerances --samples 256"
+        "pass a file name or its stem.",
+        epilog="Examples:\n  gearcheck study differential_tolerances --samples 256"
         "\n  gearcheck study my_study.toml --scheduler tcp://10.0.0.5:8786\n  gearcheck study track_wear "
         "--scheduler local-cluster --jobs 2",
     )
@@ -220,10 +204,27 @@ def build_parser() -> argparse.ArgumentParser:
     templates = sub.add_parser("templates", formatter_class=_Formatter,
                                help="list the templates shipped with gearcheck, or copy them to a folder",
                                description="List the templates shipped with gearcheck (file, mechanism, what it "
-                               "models), or copy them into DIR to edit: `gearcheck templates --copy my_designs`.")
+                               "models), or copy them into DIR to edit, with the JSON Schemas their first lines "
+                               "point to (DIR/schema/): `gearcheck templates --copy my_designs`.")
     templates.add_argument("--copy", type=Path, default=None, metavar="DIR",
-                           help="copy the shipped templates into DIR (created; an existing different file is "
-                                "not overwritten)")
+                           help="copy the shipped templates (and their schemas) into DIR (created; an existing "
+                                "different file is not overwritten)")
+
+    schema = sub.add_parser(
+        "schema", formatter_class=_Formatter,
+        help="print the JSON Schema of a mechanism's template (completion and checks in TOML editors)",
+        description="Print the JSON Schema (draft 2020-12) of a mechanism's template, made from the model that "
+        "validates it: every section and key with its description, unit and allowed range, unknown keys "
+        "refused. TOML editors (taplo, VS Code's Even Better TOML) use it through a first line "
+        "`#:schema ./schema/MECHANISM.json`, as the shipped templates have (`gearcheck templates --copy DIR` "
+        "copies the schemas too). Rules across fields (e.g. an odd tooth count, ISO 606 limits) are checked "
+        "when the template is loaded.",
+        epilog="Examples:\n  gearcheck schema track > track.schema.json\n"
+               "  gearcheck schema templates/zhurong_differential.toml   (the schema of the template's mechanism)\n"
+               "  taplo check templates/eod_track_drive.toml   (an editor's checks, from the #:schema line)",
+    )
+    schema.add_argument("mechanism", metavar="MECHANISM",
+                        help=f"a mechanism ({', '.join(names())}) or a template file naming one")
     return parser
 
 
@@ -231,23 +232,62 @@ def build_parser() -> argparse.ArgumentParser:
 # Progress and printing
 
 
-@contextlib.contextmanager
-def _bars(desc: str, total: int | None = None, unit: str = "") -> Iterator[Bar]:
-    """The pipeline's progress factory: a tqdm bar with total and ETA on a terminal, else nothing."""
-    from tqdm import tqdm
+class _Plain:
+    """Progress where stderr is not a terminal: no bars, one line when a template starts."""
 
-    with tqdm(desc=desc, total=total, unit=f" {unit}" if unit else "it", file=sys.stderr,
-              disable=not sys.stderr.isatty(), dynamic_ncols=True) as bar:
-        yield bar
+    def __enter__(self) -> _Plain:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def wait(self, desc: str) -> None:
+        print(f"{desc} ...", file=sys.stderr)
+
+    def __call__(self, desc: str, total: int | None = None, unit: str = "") -> contextlib.AbstractContextManager[Bar]:
+        from gearcheck.pipeline import no_progress
+
+        return no_progress(desc, total, unit)
 
 
-def _print_verdicts(design: Design, folder: Path, result) -> None:
-    warned = sum(v.level == "warn" for v in result.verdicts)
-    print(f"{result.level.upper()} {design.name}: {sum(v.passed for v in result.verdicts)}/{len(result.verdicts)} "
-          f"verdicts pass{f', {warned} with a warning' if warned else ''}; report {folder / 'report.html'}")
-    for v in result.verdicts:
-        word = {"pass": "pass", "warn": "warn", "fail": "FAIL"}[v.level]
-        print(f"  [{word}] {v.label}: {v.measured}" + (f" [{v.evidence}]" if v.evidence else ""))
+def _display() -> Any:
+    """Progress bars on stderr when it is a terminal, else nothing but a line per template."""
+    from gearcheck.terminal import Bars
+
+    return Bars() if sys.stderr.isatty() else _Plain()
+
+
+class _StderrHandler(logging.StreamHandler):
+    """Logs to whatever sys.stderr is now (above the progress bars while they show)."""
+
+    @property
+    def stream(self) -> Any:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value: Any) -> None:
+        pass
+
+
+def _screen() -> Screen:
+    from gearcheck.terminal import Screen
+
+    return Screen.of(sys.stdout)
+
+
+def _show(*renderables: Any) -> None:
+    from gearcheck.terminal import text
+
+    print(text(_screen(), *renderables))
+
+
+def _open(path: Path) -> None:
+    """Open a report or a folder in the web browser (a line on stderr if none opens)."""
+    import webbrowser
+
+    uri = path.absolute().as_uri()
+    if not webbrowser.open(uri):
+        print(f"gearcheck: no web browser opened {uri}", file=sys.stderr)
 
 
 # ------------------------------------------------------------------------------------------
@@ -256,14 +296,14 @@ def _print_verdicts(design: Design, folder: Path, result) -> None:
 
 def cmd_calc(args) -> int:
     from gearcheck.design import load_template
-    from gearcheck.figures import render_table
+    from gearcheck.terminal import calc_view
 
     design = load_template(args.template, args.overrides)
     calc = design.calc()
     if args.json:
         print(json.dumps(calc.to_dict(), indent=2, allow_nan=False))
     else:
-        print(render_table(f"{design.name} ({design.mechanism}) — analytical model", calc.figures))
+        _show(*calc_view(f"{design.name} ({design.mechanism}) — analytical model", calc.figures, _screen()))
     return 0
 
 
@@ -305,61 +345,96 @@ def _prepared_folders(args, designs: list[Design]) -> list[Path]:
 
 
 def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | None,
-               overrides: list[str] | tuple = (), extra_files: dict | None = None) -> bool:
+               overrides: list[str] | tuple = (), extra_files: dict | None = None) -> CheckRun:
     from gearcheck import pipeline
 
-    print(f"building {design.name} ({design.mechanism}) ...", file=sys.stderr)
-    run = pipeline.check(design, folder, tol_mm=tol_mm, jobs=jobs, progress=_bars, overrides=overrides,
-                         extra_files=extra_files)
-    print(f"wrote {folder}/ : {len(run.build.parts)} parts, {run.build.manifest['step']['file']}, manifest.json")
-    _print_verdicts(design, folder, run.result)
-    return run.passed
+    with _display() as bars:
+        bars.wait(f"building {design.name} ({design.mechanism})")
+        return pipeline.check(design, folder, tol_mm=tol_mm, jobs=jobs, progress=bars, overrides=overrides,
+                              extra_files=extra_files)
+
+
+def _show_check(run: CheckRun, *extra: str) -> None:
+    """The verdicts first, then any pointer lines, then what was written."""
+    from gearcheck.terminal import files_line, verdicts_view
+
+    design = run.build.design
+    _show(*verdicts_view(run.result, design.name, run.folder, _screen()), *extra,
+          files_line(run.folder, run.files, len(run.build.parts)))
+
+
+def _print_json(objects: list[dict], every: bool) -> None:
+    """One JSON object on stdout: the run's, or {"runs": [...]} for --all."""
+    print(json.dumps({"runs": objects} if every else objects[0], indent=2, allow_nan=False))
 
 
 def cmd_check(args) -> int:
+    from gearcheck.terminal import check_json
+
     designs = _templates_or_one(args)
     folders = _prepared_folders(args, designs)
-    passed = [_check_one(d, folder, args.tol, args.jobs, args.overrides)
-              for d, folder in zip(designs, folders, strict=True)]
-    return 0 if all(passed) else 1
+    runs = []
+    for d, folder in zip(designs, folders, strict=True):
+        runs.append(run := _check_one(d, folder, args.tol, args.jobs, args.overrides))
+        if not args.json:
+            _show_check(run)
+    if args.json:
+        _print_json([check_json(r) for r in runs], args.all)
+    if args.open:
+        for run in runs:
+            _open(run.folder / "report.html")
+    return 0 if all(r.passed for r in runs) else 1
 
 
 def _build_task(_state: Any, design: Design, folder: Path, tol_mm: float | None,
-                overrides: list[str]) -> tuple[int, str]:
-    """One template's build (module-level: --all --jobs N builds templates in worker processes)."""
+                overrides: list[str], progress: Any = None) -> dict:
+    """One template's build, as build --json shows it (module-level: --all --jobs N builds
+    templates in worker processes)."""
     from gearcheck import pipeline
+    from gearcheck.terminal import build_json
 
-    run = pipeline.build(design, folder, tol_mm=tol_mm, overrides=overrides)
-    return len(run.parts), run.manifest["step"]["file"]
+    run = pipeline.build(design, folder, tol_mm=tol_mm, overrides=overrides,
+                         progress=progress or pipeline.no_progress)
+    return build_json(run)
 
 
 def cmd_build(args) -> int:
     from gearcheck.executor import make_executor
+    from gearcheck.terminal import files_line
 
     designs = _templates_or_one(args)
     folders = _prepared_folders(args, designs)
     executor = make_executor(args.jobs)
     if executor.jobs > 1 and len(designs) > 1:
         tasks = [(d, f, args.tol, args.overrides) for d, f in zip(designs, folders, strict=True)]
-        with _bars("building", len(tasks), "template") as bar:
+        with _display() as bars, bars("building", len(tasks), "template") as bar:
             built = executor.map(_build_task, tasks, progress=bar.update)
     else:
         built = []
         for d, f in zip(designs, folders, strict=True):
-            print(f"building {d.name} ({d.mechanism}) ...", file=sys.stderr)
-            built.append(_build_task(None, d, f, args.tol, args.overrides))
-    for (n_parts, step), folder in zip(built, folders, strict=True):
-        print(f"wrote {folder}/ : {n_parts} parts, {step}, manifest.json")
+            with _display() as bars:
+                bars.wait(f"building {d.name} ({d.mechanism})")
+                built.append(_build_task(None, d, f, args.tol, args.overrides, bars))
+    if args.json:
+        _print_json(built, args.all)
+    else:
+        for b, folder in zip(built, folders, strict=True):
+            _show(files_line(folder, [Path(b["folder"]) / f["file"] for f in b["files"]], len(b["parts"])))
+    if args.open:
+        for b in built:
+            _open(Path(b["folder"]))
     return 0
 
 
 def cmd_demo(args) -> int:
     """Every template: the analytical figures (calc.json, calc.txt), then `check` (CAD, sweep,
-    report) unless --no-cad. Exit 1 if any verdict fails, after every template has run."""
+    report) unless --no-cad; the verdicts of each, and a pointer to its figures. Exit 1 if any
+    verdict fails, after every template has run."""
     from gearcheck import pipeline
     from gearcheck.design import find_templates, load_template
     from gearcheck.figures import render_table
     from gearcheck.output import check_out_target, ensure_out_dir
+    from gearcheck.terminal import calc_pointer
 
     _, templates = find_templates(args.templates)
     designs = [load_template(path) for path in templates]  # validate every template first
@@ -372,30 +447,38 @@ def cmd_demo(args) -> int:
         calc = design.calc()
         table = render_table(f"{design.name} ({design.mechanism}) — analytical model", calc.figures)
         files = {"calc.json": json.dumps(calc.to_dict(), indent=2, allow_nan=False) + "\n", "calc.txt": table + "\n"}
-        print(table)
-        print()
+        pointer = calc_pointer(calc.figures, folder / "calc.txt")
         if args.no_cad:
             pipeline.write_files(design, folder, files)
+            _show(f"{design.name} ({design.mechanism}): {pointer}")
         else:
-            passed.append(_check_one(design, folder, None, args.jobs, extra_files=files))
+            run = _check_one(design, folder, None, args.jobs, extra_files=files)
+            passed.append(run.passed)
+            _show_check(run, f"  calc: {pointer}")
             print()
     print(f"wrote {len(designs)} result folders under {args.out}/ (open NAME/report.html)")
+    if args.open:
+        for folder in ([args.out] if args.no_cad else [f / "report.html" for f in folders]):
+            _open(folder)
     return 0 if all(passed) else 1
 
 
 def cmd_templates(args) -> int:
-    """List the shipped templates, or copy them into --copy DIR."""
+    """List the shipped templates, or copy them (and the schemas they point to) into --copy DIR."""
     import shutil
 
     from gearcheck.design import load_template, packaged_templates
     from gearcheck.output import OutputError, ensure_out_dir
+    from gearcheck.schema import SCHEMA_FOLDER
 
     shipped = sorted(packaged_templates().glob("*.toml"))
+    schemas = sorted((packaged_templates() / SCHEMA_FOLDER).glob("*.json"))
     if args.copy is None:
         for path in shipped:
             design = load_template(path)
             print(f"{path.name:32s} {design.mechanism:13s} {design.impl.title}")
-        print(f"({len(shipped)} templates in {packaged_templates()}; copy them with --copy DIR)")
+        print(f"({len(shipped)} templates in {packaged_templates()}; copy them with --copy DIR; "
+              f"their JSON Schemas: gearcheck schema MECHANISM)")
         from gearcheck.studies.spec import load_spec, packaged_studies
 
         studies = sorted(packaged_studies().glob("*.toml"))
@@ -405,12 +488,30 @@ def cmd_templates(args) -> int:
         print(f"({len(studies)} studies; run one with `gearcheck study NAME`)")
         return 0
     folder = ensure_out_dir(args.copy)
-    for path in shipped:
-        target = folder / path.name
+    copies = [(p, folder / p.name) for p in shipped] + [(p, folder / SCHEMA_FOLDER / p.name) for p in schemas]
+    for path, target in copies:
         if target.exists() and target.read_bytes() != path.read_bytes():
-            raise OutputError(target, "exists and differs from the shipped template (not overwritten)")
+            raise OutputError(target, "exists and differs from the shipped file (not overwritten)")
+    for path, target in copies:
+        target.parent.mkdir(exist_ok=True)
         shutil.copyfile(path, target)
-    print(f"copied {len(shipped)} templates to {folder}/")
+    print(f"copied {len(shipped)} templates to {folder}/ (their schemas to {folder / SCHEMA_FOLDER}/)")
+    return 0
+
+
+def cmd_schema(args) -> int:
+    """The JSON Schema of a mechanism's template (by name, or of a template file's mechanism)."""
+    from gearcheck.mechanism import names
+    from gearcheck.params import ParamError
+    from gearcheck.params.common import read_toml
+    from gearcheck.schema import schema_text
+
+    name = args.mechanism
+    if name not in names() and name.endswith(".toml"):
+        name = read_toml(Path(name)).get("mechanism")
+    if name not in names():
+        raise ParamError("MECHANISM", args.mechanism, f"allowed one of: {', '.join(names())}, or a template file")
+    sys.stdout.write(schema_text(name))
     return 0
 
 
@@ -421,8 +522,9 @@ def cmd_study(args) -> int:
 
     path = find_study(args.study)
     out = args.out if args.out is not None else Path("out") / f"study_{path.stem}"
-    result = study(path, samples=args.samples, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler, out=out,
-                   exact=args.exact, check_worst=args.check_worst, progress=_bars)
+    with _display() as bars:
+        result = study(path, samples=args.samples, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
+                       out=out, exact=args.exact, check_worst=args.check_worst, progress=bars)
     s = result.summary
     print(f"{s['study']}: {s['valid']} valid variants of {s['samples']} ({s['rejected']} rejected), "
           f"exact model on {s['exact_variants']}")
@@ -439,7 +541,7 @@ def cmd_study(args) -> int:
 
 
 COMMANDS = {"calc": cmd_calc, "study": cmd_study, "build": cmd_build, "check": cmd_check, "demo": cmd_demo,
-            "templates": cmd_templates}
+            "templates": cmd_templates, "schema": cmd_schema}
 
 
 def _error(text: str) -> int:
@@ -484,8 +586,8 @@ def _main(argv: list[str] | None) -> int:
             stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
-                        format="gearcheck: %(message)s", stream=sys.stderr)
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[_StderrHandler()],
+                        format="gearcheck: %(message)s")
     from gearcheck.output import output_error
     from gearcheck.params import ParamError
 

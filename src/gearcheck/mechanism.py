@@ -151,6 +151,12 @@ class Mechanism(ABC):
         nothing to resolve (zero-backlash contact decided within a contact tolerance)."""
         return None
 
+    def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
+        """Key frames of the mechanism's motion for the report's 3D view and the GLB's animation
+        (:class:`gearcheck.scene.PoseView` each: the moving parts' poses), and what they step
+        through ("towing swing angle, °"); none by default (numpy only)."""
+        return [], ""
+
     # -- the CAD hook -------------------------------------------------------------------------
     @abstractmethod
     def parts(self, assembly: Assembly) -> list[Part]:

@@ -118,11 +118,13 @@ class BuildRun:
     files: list[Path] = field(default_factory=list)  # every file of the run (after the swap)
 
 
-def build_parts(design: Design) -> tuple[Assembly, list[Part]]:
+def build_parts(design: Design, progress: ProgressFactory = no_progress) -> tuple[Assembly, list[Part]]:
     """The assembly as data and its solids (CadQuery), no files."""
     impl = design.impl
     assembly = impl.assembly(design.params)
-    parts = impl.parts(assembly)
+    with progress(f"solids of {design.name}", len(assembly.names), "part") as bar:
+        parts = impl.parts(assembly)
+        bar.update(len(parts))
     if [p.name for p in parts] != assembly.names:
         raise RuntimeError(f"{impl.name}: parts() must return the assembly's parts in order, "
                            f"got {[p.name for p in parts]} for {assembly.names}")
@@ -144,15 +146,15 @@ def sweep_bodies(exported: list[ExportedPart]) -> dict[str, Body]:
 
 
 def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: ProgressFactory,
-                overrides: Sequence[str] = ()) -> BuildRun:
-    """Solids, meshes, STEP/STL/params.toml/manifest.json written into ``folder`` (a staging
-    folder: the caller commits it)."""
+                overrides: Sequence[str] = (), geometry: bool = False) -> BuildRun:
+    """Solids, meshes, STEP/STL/params.toml/manifest.json (and with ``geometry`` NAME.glb)
+    written into ``folder`` (a staging folder: the caller commits it)."""
     from gearcheck.cad.export import export_parts
 
     plan = mesh_plan(design, tol_mm)
     tol = plan.tol_mm
     log.info("stage build: %s (%s), solids", design.name, design.mechanism)
-    assembly, parts = build_parts(design)
+    assembly, parts = build_parts(design, progress)
     log.info("stage mesh: %s, %d parts at %g mm", design.name, len(parts), tol)
     with progress(f"meshing {design.name}", len(parts), "part") as bar:
         manifest, exported = export_parts(parts, folder, name=design.name, mechanism=design.mechanism,
@@ -160,6 +162,11 @@ def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: Pr
                                           extra={"mesh_tolerance": plan.manifest()},
                                           progress=lambda _name: bar.update(1),
                                           params_comment=provenance(design, overrides))
+    if geometry:
+        from gearcheck.views import scene_of, write_geometry
+
+        log.info("stage geometry: %s.glb", design.name)
+        write_geometry(folder, scene_of(design, assembly, parts), pictures=False, viewer=False)
     return BuildRun(design, folder, tol, plan, assembly, parts, exported, sweep_bodies(exported), manifest)
 
 
@@ -214,7 +221,7 @@ def build(design: Design, folder: Path, *, tol_mm: float | None = None,
 
     check_tol(tol_mm)
     with RunFolder(folder) as txn:
-        run = _build_into(design, txn.staging, tol_mm, progress, overrides)
+        run = _build_into(design, txn.staging, tol_mm, progress, overrides, geometry=True)
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()
     _rooted(run, target, ["manifest.json", *run.manifest["files"]])
@@ -280,7 +287,7 @@ def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
 def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
             progress: ProgressFactory = no_progress) -> list[Confirmation]:
     """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
-    from gearcheck.cad.confirm import exact_distance, exact_overlap
+    from gearcheck.cad.confirm import exact_closest, exact_overlap_closest
     from gearcheck.sweep.tools import mesh_nearest_midpoint, meshes_overlap
 
     by_name = {p.name: p for p in parts}
@@ -292,12 +299,16 @@ def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
             overlap = None
             if worst.mesh_distance_mm <= 0.0 or meshes_overlap(bodies, worst):
                 # the meshes' nearest points mean nothing here: measure the whole solids
-                brep, overlap = exact_overlap(by_name, worst)
+                brep, overlap, point_a, point_b = exact_overlap_closest(by_name, worst)
             else:
-                brep = exact_distance(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
+                brep, point_a, point_b = exact_closest(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
             out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
-                                    worst.mesh_distance_mm, brep, bound, overlap))
+                                    worst.mesh_distance_mm, brep, bound, overlap,
+                                    tuple(float(v) for v in point_a), tuple(float(v) for v in point_b)))
             bar.update(1)
+    keys = [c.key for c in out]
+    if len(set(keys)) != len(keys):  # summary.json keeps one entry per key: none may be lost
+        raise RuntimeError(f"worst poses must have distinct keys, got {keys}")
     return out
 
 
@@ -349,12 +360,16 @@ class CheckRun:
         return self.result.verdicts
 
 
-def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict) -> tuple[list[Path], dict]:
+def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict, *,
+                 overrides: Sequence[str] = (), geometry: Any = None) -> tuple[list[Path], dict]:
     """summary.json, sweep.csv and report.html (each atomically, in the run's staging folder);
-    the files and summary.json's data."""
+    the files and summary.json's data. ``geometry``: the run's :class:`gearcheck.views.Geometry`
+    (its 3D view and pictures go into the report)."""
     from gearcheck.output import atomic_write_text
     from gearcheck.report.files import summary_json, sweep_csv
     from gearcheck.report.html import render
+    from gearcheck.report.inputs import input_rows, template_header
+    from gearcheck.views import run_files
 
     log.info("stage report: %s", design.name)
     summary = summary_json(result)
@@ -365,10 +380,28 @@ def write_report(design: Design, folder: Path, result: CheckResult, manifest: di
         "triangles": sum(p["triangles"] for p in manifest["parts"]),
         "parts": len(manifest["parts"]),
     }
+    if geometry is not None:
+        result.notes.extend(geometry.notes)
     page = render(result, title=f"gearcheck: {design.name} ({design.mechanism})", template=design.source,
-                  build=build_info)
+                  build=build_info, inputs=input_rows(design, overrides),
+                  files=run_files(folder, [*REPORT_FILES, "manifest.json"]),
+                  viewer=geometry.viewer if geometry is not None else "",
+                  pictures=geometry.pictures if geometry is not None else (), about=template_header(design))
     atomic_write_text(folder / "report.html", page)
     return [folder / n for n in REPORT_FILES], json.loads(summary)
+
+
+def _geometry(design: Design, run: BuildRun, result: CheckResult, progress: ProgressFactory) -> Any:
+    """NAME.glb with the worst poses, the pictures and the report's 3D view of a check."""
+    from gearcheck.views import scene_of, write_geometry
+
+    log.info("stage geometry: %s.glb, pictures, 3D view", design.name)
+    with progress("drawing the geometry", 3, "step") as bar:
+        scene = scene_of(design, run.assembly, run.parts, result)
+        bar.update(1)
+        geometry = write_geometry(run.folder, scene, pictures=True, viewer=True)
+        bar.update(2)
+    return geometry
 
 
 def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: int | None = None,
@@ -388,7 +421,8 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
                        progress=progress, mesh_plan=run.mesh_plan)
         result.confirmations = confirm(result, run.parts, run.bodies, progress)
         result.verdicts.append(confirmation_verdict(result.confirmations, result.resolution))
-        _, summary = write_report(design, txn.staging, result, run.manifest)
+        geometry = _geometry(design, run, result, progress)
+        _, summary = write_report(design, txn.staging, result, run.manifest, overrides=overrides, geometry=geometry)
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()
     _rooted(run, target, ["manifest.json", *run.manifest["files"]])

@@ -34,6 +34,10 @@ class Verdict:
     measured: str
     figures: Mapping[str, float] = field(default_factory=dict)
     evidence: str = ""
+    # for a verdict that fails or warns: the deciding figure against what is required and by how
+    # much it falls short, in words ("least tip–plate distance 0.0500 mm, required ≥ 0.5 mm, short
+    # by 0.4500 mm"); the report's banner names it. Empty on a pass. Not in summary.json.
+    shortfall: str = ""
 
     def __post_init__(self) -> None:
         if self.level not in LEVELS:
@@ -41,15 +45,16 @@ class Verdict:
 
     @classmethod
     def of(cls, name: str, label: str, passed: bool, measured: str,
-           figures: Mapping[str, float] | None = None, evidence: str = "") -> Verdict:
-        """A pass/fail verdict."""
-        return cls(name, label, "pass" if passed else "fail", measured, dict(figures or {}), evidence)
+           figures: Mapping[str, float] | None = None, evidence: str = "", shortfall: str = "") -> Verdict:
+        """A pass/fail verdict (``shortfall`` is kept only when it fails)."""
+        return cls(name, label, "pass" if passed else "fail", measured, dict(figures or {}), evidence,
+                   "" if passed else shortfall)
 
     @classmethod
     def graded(cls, name: str, label: str, level: Level, measured: str,
-               figures: Mapping[str, float] | None = None, evidence: str = "") -> Verdict:
-        """A verdict at any level (pass / warn / fail)."""
-        return cls(name, label, level, measured, dict(figures or {}), evidence)
+               figures: Mapping[str, float] | None = None, evidence: str = "", shortfall: str = "") -> Verdict:
+        """A verdict at any level (pass / warn / fail; ``shortfall`` is kept unless it passes)."""
+        return cls(name, label, level, measured, dict(figures or {}), evidence, "" if level == "pass" else shortfall)
 
     @property
     def passed(self) -> bool:
@@ -59,7 +64,15 @@ class Verdict:
 
 @dataclass(frozen=True)
 class Comparison:
-    """One row of the paper vs model vs geometry table (None where a column has no value)."""
+    """One row of the paper vs model vs geometry table (None where a column has no value).
+
+    The report flags the difference of each computed column from the paper (else from the
+    analytical model) by its size; ``note`` says why they differ. ``paper_is``: the paper's figure
+    is a value, or a bound the design must meet ("min": the figure must be ≥ it, "max": ≤ it).
+    ``digits``: decimals of the computed columns (the paper's figure is shown as printed);
+    ``tolerance``: the mesh sweep's differences up to this (in ``unit``: its error bound) are
+    agreement; ``compared`` False: the columns hold different quantities side by side (a declared
+    value and its limit), not estimates of one figure, so no difference is flagged."""
 
     label: str
     unit: str
@@ -68,6 +81,10 @@ class Comparison:
     geometry: float | None
     note: str = ""
     exact: float | None = None  # an independent exact (non-mesh) model, where there is one
+    digits: int | None = None
+    paper_is: Literal["value", "min", "max"] = "value"
+    tolerance: float = 0.0
+    compared: bool = True
 
 
 @dataclass(frozen=True)
@@ -86,6 +103,8 @@ class Plot:
     series: list[Series]
     markers: list[tuple[str, float]] = field(default_factory=list)  # vertical lines: (label, x)
     hlines: list[tuple[str, float]] = field(default_factory=list)  # horizontal lines: (label, y)
+    ylim: tuple[float, float] | None = None  # a zoom on the values a verdict decides (None: all data)
+    caption: str = ""  # what the plot shows and what to read from it, under the plot
 
 
 @dataclass(frozen=True)
@@ -112,7 +131,8 @@ class WorstPose:
     def json_key(self) -> str:
         if self.key:
             return self.key
-        slug = "".join(c if c.isascii() and c.isalnum() else "_" for c in self.label.lower())
+        label = self.label.lower().replace("+", " plus ").replace("−", " minus ")  # "towing +" ≠ "towing −"
+        slug = "".join(c if c.isascii() and c.isalnum() else "_" for c in label)
         return "_".join(filter(None, slug.split("_")))[:80]
 
 
@@ -137,6 +157,9 @@ class Confirmation:
     bound_mm: float
     # where the meshes overlap at the pose: the exact solids' common volume (mm³); None when free
     overlap_mm3: float | None = None
+    # the exact solids' closest points at the pose (world, mm; one common point where they touch)
+    point_a: tuple[float, ...] | None = None
+    point_b: tuple[float, ...] | None = None
 
     @property
     def meshes_overlap(self) -> bool:
@@ -198,7 +221,7 @@ class CheckResult:
     rows: list[dict]  # one per pose, flat, same keys in every row: sweep.csv
     comparisons: list[Comparison] = field(default_factory=list)
     plots: list[Plot] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)  # findings in words, for the report
+    notes: list[str] = field(default_factory=list)  # what the check found, in words, for the report
     worst_poses: list[WorstPose] = field(default_factory=list)
     # wall-clock figures (s, poses/s): for benchmarks and the terminal, never in summary.json,
     # which must be byte-identical between runs

@@ -11,7 +11,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import math
+
 import numpy as np
+
+# A B-rep distance below this (mm) is a touch: the solids meet (OCC's own precision is 1e-7 mm).
+TOUCH_MM = 1e-6
+
+
+def distance_text(mm: float | None) -> str:
+    """A worst pose's distance as the 3D view and the pictures print it ("" when unknown)."""
+    if mm is None or not math.isfinite(mm):
+        return ""
+    if abs(mm) < TOUCH_MM:
+        return "touching, 0 mm"
+    return f"{mm:.4f} mm" if abs(mm) >= 1e-3 else f"{mm:.2e} mm"
 
 
 @dataclass(frozen=True)

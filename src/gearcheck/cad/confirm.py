@@ -57,29 +57,59 @@ def _faces_near(shape, point: np.ndarray, radius: float):
     return compound if count else shape.wrapped
 
 
+def _measure(a, b, label: str) -> BRepExtrema_DistShapeShape:
+    dist = BRepExtrema_DistShapeShape(a, b)
+    if not dist.IsDone():
+        raise RuntimeError(f"BRepExtrema failed at {label}")
+    return dist
+
+
+def _nearest_pair(dist: BRepExtrema_DistShapeShape) -> tuple[np.ndarray, np.ndarray]:
+    """The closest points (world, mm) of a measured pair: of its solutions, the first (OCC may
+    list several equal-distance pairs, e.g. along a line contact)."""
+    if dist.NbSolution() < 1:
+        raise RuntimeError("BRepExtrema gave no closest points")
+    a, b = dist.PointOnShape1(1), dist.PointOnShape2(1)
+    return np.array([a.X(), a.Y(), a.Z()]), np.array([b.X(), b.Y(), b.Z()])
+
+
+def exact_closest(parts: dict[str, Part], worst: WorstPose, near: np.ndarray | None = None,
+                  radius: float = NEAR_RADIUS_MM) -> tuple[float, np.ndarray, np.ndarray]:
+    """(exact distance, closest point on part_a, closest point on part_b) at the worst pose, the
+    points in world coordinates (mm, the parts posed and scaled as in the worst pose); with
+    ``near`` only the faces around it are measured, as :func:`exact_distance`. Where the solids
+    intersect the distance is 0 and the points are one common point."""
+    a = _posed(parts, worst.part_a, worst.pose_a, worst.scale_a)
+    b = _posed(parts, worst.part_b, worst.pose_b, worst.scale_b)
+    if near is not None:
+        dist = _measure(_faces_near(a, near, radius), _faces_near(b, near, radius), worst.label)
+    else:
+        dist = _measure(a.wrapped, b.wrapped, worst.label)
+    point_a, point_b = _nearest_pair(dist)
+    return float(dist.Value()), point_a, point_b
+
+
 def exact_distance(parts: dict[str, Part], worst: WorstPose, near: np.ndarray | None = None,
                    radius: float = NEAR_RADIUS_MM) -> float:
     """Exact distance between the two solids at the worst pose; with ``near`` (world point, e.g.
     the midpoint of the mesh's nearest points) only the faces around it are measured."""
-    a = _posed(parts, worst.part_a, worst.pose_a, worst.scale_a)
-    b = _posed(parts, worst.part_b, worst.pose_b, worst.scale_b)
-    if near is not None:
-        dist = BRepExtrema_DistShapeShape(_faces_near(a, near, radius), _faces_near(b, near, radius))
-    else:
-        dist = BRepExtrema_DistShapeShape(a.wrapped, b.wrapped)
-    if not dist.IsDone():
-        raise RuntimeError(f"BRepExtrema failed at {worst.label}")
-    return float(dist.Value())
+    return exact_closest(parts, worst, near, radius)[0]
 
 
 def exact_overlap(parts: dict[str, Part], worst: WorstPose) -> tuple[float, float]:
     """(distance, common volume in mm³) of the two whole solids at the worst pose: for poses
     where the meshes overlap (distance 0 when the solids intersect)."""
+    distance, volume, _, _ = exact_overlap_closest(parts, worst)
+    return distance, volume
+
+
+def exact_overlap_closest(parts: dict[str, Part], worst: WorstPose) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """:func:`exact_overlap` with the closest points (world, mm) of the two whole solids: where
+    they intersect, one point common to both (distance 0)."""
     a = _posed(parts, worst.part_a, worst.pose_a, worst.scale_a)
     b = _posed(parts, worst.part_b, worst.pose_b, worst.scale_b)
-    dist = BRepExtrema_DistShapeShape(a.wrapped, b.wrapped)
-    if not dist.IsDone():
-        raise RuntimeError(f"BRepExtrema failed at {worst.label}")
+    dist = _measure(a.wrapped, b.wrapped, worst.label)
+    point_a, point_b = _nearest_pair(dist)
     # a fuzzy Boolean (tolerance far below any mesh bound): the plain one returned a negative
     # volume on the differential's cold gears, whose flanks cross at grazing angles
     common = boolean_common(a.wrapped, b.wrapped, fuzzy_mm=COMMON_FUZZY_MM)
@@ -89,4 +119,4 @@ def exact_overlap(parts: dict[str, Part], worst: WorstPose) -> tuple[float, floa
         BRepGProp.VolumeProperties_s(common, props)
         if props.Mass() >= 0.0:
             volume = float(props.Mass())
-    return float(dist.Value()), volume
+    return float(dist.Value()), volume, point_a, point_b

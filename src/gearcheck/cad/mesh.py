@@ -87,21 +87,27 @@ def _faces_of(shape):
         explorer.Next()
 
 
-def mesh_shape(shape, tol_mm: float = CHORDAL_TOL_MM, angular_rad: float = ANGULAR_TOL_RAD,
-               error_samples: int = ERROR_SAMPLES, seed: int = 0) -> TriMesh:
-    """Tessellate a cadquery Shape (or TopoDS_Shape) and return a merged, watertight mesh."""
-    topo = getattr(shape, "wrapped", shape)
-    BRepTools.Clean_s(topo)
+def triangulate(topo, tol_mm: float, angular_rad: float) -> None:
+    """Triangulate an OCC shape in place at an absolute chordal tolerance (mm) and an angular one
+    (rad). Analytic surfaces (the big back/front cones with a toothed boundary) are otherwise
+    split by a fixed range rule and measured up to 2.3 × tol_mm off: they are checked against the
+    deflection like B-splines."""
     params = IMeshTools_Parameters()
     params.Deflection = tol_mm
     params.Angle = angular_rad
     params.Relative = False
     params.InParallel = True
-    # analytic surfaces (the big back/front cones with a toothed boundary) are otherwise split
-    # by a fixed range rule and measured up to 2.3 × tol_mm off; check them like B-splines
     params.ControlSurfaceDeflection = True
     params.EnableControlSurfaceDeflectionAllSurfaces = True
     BRepMesh_IncrementalMesh(topo, params)
+
+
+def mesh_shape(shape, tol_mm: float = CHORDAL_TOL_MM, angular_rad: float = ANGULAR_TOL_RAD,
+               error_samples: int = ERROR_SAMPLES, seed: int = 0) -> TriMesh:
+    """Tessellate a cadquery Shape (or TopoDS_Shape) and return a merged, watertight mesh."""
+    topo = getattr(shape, "wrapped", shape)
+    BRepTools.Clean_s(topo)
+    triangulate(topo, tol_mm, angular_rad)
 
     verts: list[np.ndarray] = []
     uvs: list[np.ndarray] = []

@@ -40,6 +40,11 @@ class Differential(Mechanism):
 
         return build_assembly(params)
 
+    def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
+        from gearcheck.mechanisms.differential.display import display_frames
+
+        return display_frames(params, assembly)
+
     def smallest_clearance(self, params: DifferentialParams) -> Clearance | None:
         """The least play per side (exact flanks, cycle minimum) at the template's shim over the
         meshed temperatures (warm, the cold design point, the operating range's ends, the storage

@@ -60,7 +60,8 @@ def _warm(data: SweepData, resolves: bool) -> Verdict:
         f"mesh bound ±{2 * data.bound_arcmin:.2f}′ on a play",
         {"centred_poses_free": float(warm_free), "geom_warm_play_min_arcmin": float(geom_min[t, w]),
          "exact_warm_play_min_arcmin": float(exact_min[t, w])},
-        evidence=_play_evidence(data, resolves, f"{data.states[w][1]:g} °C"))
+        evidence=_play_evidence(data, resolves, f"{data.states[w][1]:g} °C"),
+        shortfall=_play_shortfall("least warm play", float(geom_min[t, w]), float(exact_min[t, w]), warm_free))
 
 
 def _cold(data: SweepData, resolves: bool) -> Verdict:
@@ -80,7 +81,24 @@ def _cold(data: SweepData, resolves: bool) -> Verdict:
         f"{np.nanmax(data.total_dev[t, c]):.3f}′ here)",
         {"centred_poses_free": float(centred_free), "geom_cold_play_min_arcmin": float(geom_min[t, c]),
          "exact_cold_play_min_arcmin": float(exact_min[t, c])},
-        evidence=_play_evidence(data, resolves, f"{data.states[c][1]:g} °C"))
+        evidence=_play_evidence(data, resolves, f"{data.states[c][1]:g} °C"),
+        shortfall=_play_shortfall(f"least cold play at {data.states[c][1]:g} °C", float(geom_min[t, c]),
+                                  float(exact_min[t, c]), centred_free))
+
+
+def _play_shortfall(what: str, geom: float, exact: float, free: bool) -> str:
+    """A play verdict's shortfall: the least play against the required > 0 (negative: the flanks
+    overlap by that angle)."""
+    least = min(geom, exact)
+    text = f"{what} {geom:.3f}′ per side (geometry), exact {exact:.3f}′, required > 0"
+    if least <= 0:
+        text += f", short by {-least:.3f}′ (the flanks overlap)"
+    return text + ("" if free else "; centred poses collide")
+
+
+def _range_shortfall(span: str, least: float, at: float, depth_um: float) -> str:
+    text = f"least play over {span} {least:.3f}′ per side at {at:g} °C (exact), required > 0"
+    return text + (f", short by {-least:.3f}′ ({depth_um:.2f} µm overlap on d1/2)" if least <= 0 else "")
 
 
 def _unsolved(r, lo: float, hi: float) -> str:
@@ -125,7 +143,9 @@ def _operating(params, data: SweepData, resolves: bool) -> Verdict:
         f"least exact play {least:.3f}′ per side at {at:g} °C"
         + (f" — binds: the flanks overlap by {r.depth_um(least):.2f} µm on d1/2" if least <= 0 else "")
         + _unsolved(r, op.operating_min_C, op.operating_max_C) + f"; meshed: {_mesh_text(data, meshed)}",
-        figures, evidence=evidence)
+        figures, evidence=evidence,
+        shortfall=_range_shortfall(f"{op.operating_min_C:g}…{op.operating_max_C:g} °C", least, at, r.depth_um(least))
+        + (f"; geometry {mesh_least:.3f}′" if math.isfinite(mesh_least) and mesh_least <= 0 else ""))
 
 
 def _storage(params, data: SweepData) -> Verdict:
@@ -151,7 +171,8 @@ def _storage(params, data: SweepData) -> Verdict:
             "storage_play_positive",
             f"play > 0 over the storage range {op.storage_min_C:g}…{op.storage_max_C:g} °C at shim "
             f"{shim_text(data.shims[data.t])} mm", "warn",
-            "not decided" + _unsolved(r, op.storage_min_C, op.storage_max_C), figures, evidence=evidence)
+            "not decided" + _unsolved(r, op.storage_min_C, op.storage_max_C), figures, evidence=evidence,
+            shortfall="not decided: " + _unsolved(r, op.storage_min_C, op.storage_max_C).removeprefix("; "))
     if onset is not None:
         figures["binding_onset_C"] = onset
     deep = r.at("storage_min")
@@ -165,7 +186,10 @@ def _storage(params, data: SweepData) -> Verdict:
         f"{shim_text(data.shims[data.t])} mm", "warn",
         f"binds in storage: {where}; at the storage minimum {op.storage_min_C:g} °C the flanks overlap by "
         f"{-deep:.3f}′ per side ({r.depth_um(deep):.2f} µm on d1/2){also}; meshed: {_mesh_text(data, meshed)}",
-        figures, evidence=evidence)
+        figures, evidence=evidence,
+        shortfall=(f"play per side required > 0 down to {op.storage_min_C:g} °C; "
+                   + (f"binds from {onset:.2f} °C, " if onset is not None else "binds, ")
+                   + f"at {op.storage_min_C:g} °C short by {-deep:.3f}′ ({r.depth_um(deep):.2f} µm overlap on d1/2)"))
 
 
 def _agreement(data: SweepData) -> Verdict:
@@ -179,4 +203,12 @@ def _agreement(data: SweepData) -> Verdict:
         "contact, twice the bound per play",
         {"max_contact_deviation_arcmin": float(data.contact_dev.max()),
          "max_play_deviation_arcmin": float(np.nanmax(total_dev)), "mesh_error_bound_arcmin": data.bound_arcmin},
-        evidence="mesh sweep against the exact model, contact by contact")
+        evidence="mesh sweep against the exact model, contact by contact",
+        shortfall=_agreement_shortfall(data))
+
+
+def _agreement_shortfall(data: SweepData) -> str:
+    over = [what for what, ok in (("per contact", data.contact_ok), ("per play", data.total_ok)) if not ok]
+    return (f"mesh against exact: {data.contact_dev.max():.3f}′ per contact (allowed {data.bound_arcmin:.2f}′ + "
+            f"{AGREEMENT_RELATIVE:.0%}), {np.nanmax(data.total_dev):.3f}′ per play (allowed "
+            f"{2 * data.bound_arcmin:.2f}′ + {AGREEMENT_RELATIVE:.0%}): beyond the allowance {' and '.join(over)}")

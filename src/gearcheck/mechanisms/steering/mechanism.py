@@ -50,6 +50,11 @@ class Steering(Mechanism):
     def assembly(self, params: SteeringParams) -> Assembly:
         return _assembly.assembly(params)
 
+    def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
+        from gearcheck.mechanisms.steering.display import display_frames
+
+        return display_frames(params, assembly)
+
     def parts(self, assembly: Assembly) -> list[Part]:
         from gearcheck.mechanisms.steering.parts import parts
 

@@ -77,25 +77,84 @@ def tooth_pairs(g: RackPinionGeometry) -> list[tuple[int, int]]:
     return [(j, k) for j, ks in _tooth_pairs_by_pinion(g).items() for k in ks]
 
 
-def _offsets(px, py, flat, inv_dy, slope_x, chain, want_lo: bool = True, want_hi: bool = True):
+class _Side:
+    """Pinion tooth j's contact polygon at many angles (rows): its vertices (px, py, closed: the
+    first repeated last) and the edges between them, for the extremes of :func:`_offsets`."""
+
+    def __init__(self, px: np.ndarray, py: np.ndarray):
+        self.px, self.py = px[:, :-1], py[:, :-1]
+        bx, by = px[:, 1:], py[:, 1:]
+        ax, ay = px[:, :-1], py[:, :-1]
+        dy = by - ay
+        self.ex, self.ey = ax, ay
+        self.flat = dy == 0.0
+        self.inv_dy = 1.0 / np.where(self.flat, 1.0, dy)
+        self.slope_x = (bx - ax) * self.inv_dy
+
+    def rows(self, keep: np.ndarray) -> _Side:
+        out = object.__new__(_Side)
+        for name in ("px", "py", "ex", "ey", "flat", "inv_dy", "slope_x"):
+            setattr(out, name, getattr(self, name)[keep])
+        return out
+
+
+def _offsets(poly: _Side, chain, want_lo: bool = True, want_hi: bool = True):
     """min and max over the chain's heights of [pinion boundary x(y) − chain x(y)], per angle
-    (rows of the pinion polygon's vertices px, py): over the pinion vertices within the chain's
-    heights and the pinion edges crossing the chain's vertex heights (±inf where none; None for
-    an end not wanted)."""
+    (rows of the pinion polygon ``poly``): over its vertices within the chain's heights and its
+    edges crossing the chain's vertex heights (±inf where none; None for an end not wanted)."""
     ys, xs = chain
+    px, py = poly.px, poly.py
     inside = (py >= ys[0]) & (py <= ys[-1])
     d = px - np.interp(py, ys, xs)
     hi: Any = np.where(inside, d, -np.inf).max(axis=1) if want_hi else None
     lo: Any = np.where(inside, d, np.inf).min(axis=1) if want_lo else None
     for uy, ux in zip(ys, xs, strict=True):
-        t = (uy - py) * inv_dy
-        crossing = ~flat & (t >= 0.0) & (t <= 1.0)
-        x = px + (uy - py) * slope_x
+        t = (uy - poly.ey) * poly.inv_dy
+        crossing = ~poly.flat & (t >= 0.0) & (t <= 1.0)
+        x = poly.ex + (uy - poly.ey) * poly.slope_x
         if want_hi:
             hi = np.maximum(hi, np.where(crossing, x, -np.inf).max(axis=1) - ux)
         if want_lo:
             lo = np.minimum(lo, np.where(crossing, x, np.inf).min(axis=1) - ux)
     return lo, hi
+
+
+def all_intervals(g: RackPinionGeometry, phis):
+    """:func:`overlap_intervals` both ways at once (the pinion polygons rotated once): returns
+    pairs, (lo, hi) of whole teeth, (lo, hi) of the left flanks, (lo, hi) of the right flanks."""
+    phis = np.atleast_1d(np.asarray(phis, dtype=float))
+    pairs: list[tuple[int, int]] = []
+    rows: list[list[np.ndarray]] = []
+    for j, ks in _tooth_pairs_by_pinion(g).items():
+        chains = [_rack_chains(g, k) for k in ks]
+        idx = np.flatnonzero(_active(g, j, max(c[5] for c in chains), phis))
+        if idx.size:
+            rho, gam = g.pinion_contact_polygon_polar(j)
+            ang = gam[None, :] + g.pinion_tooth_angle(j, phis[idx])[:, None]
+            px = rho * np.sin(ang)
+            py = g.centre_to_datum_mm - rho * np.cos(ang)
+            closed = _Side(np.concatenate([px, px[:, :1]], axis=1), np.concatenate([py, py[:, :1]], axis=1))
+            y_min, y_max = py.min(axis=1), py.max(axis=1)
+        for k, (left_chain, right_chain, left_flank, right_flank, y0, top) in zip(ks, chains, strict=True):
+            pairs.append((j, k))
+            out = [np.full(phis.shape, np.nan) for _ in range(6)]
+            rows.append(out)
+            if not idx.size:
+                continue
+            overlap = (y_min <= top) & (y_max >= y0)
+            if not overlap.any():
+                continue
+            at = idx[overlap]
+            poly = closed.rows(overlap)
+            found = [(_offsets(poly, right_chain, want_hi=False)[0], _offsets(poly, left_chain, want_lo=False)[1]),
+                     _offsets(poly, left_flank), _offsets(poly, right_flank)]
+            for n, (lo_m, hi_m) in enumerate(found):
+                ok = np.isfinite(hi_m) & np.isfinite(lo_m)
+                out[2 * n][at[ok]] = lo_m[ok]
+                out[2 * n + 1][at[ok]] = hi_m[ok]
+    shape = (len(pairs), phis.size)
+    arrays = [np.array([r[n] for r in rows]).reshape(shape) for n in range(6)]
+    return pairs, (arrays[0], arrays[1]), (arrays[2], arrays[3]), (arrays[4], arrays[5])
 
 
 def overlap_intervals(g: RackPinionGeometry, phis, flanks: bool = False):
@@ -109,48 +168,10 @@ def overlap_intervals(g: RackPinionGeometry, phis, flanks: bool = False):
     With ``flanks`` the intervals are those of each flank segment alone (the faces that push
     the rack): returns pairs, (lo, hi) of the left flanks and (lo, hi) of the right flanks; a
     tooth in (lo, hi) of a left flank cuts it, and the rack clears it at L = hi (pushed +x)."""
-    phis = np.atleast_1d(np.asarray(phis, dtype=float))
-    pairs: list[tuple[int, int]] = []
-    rows: list[list[np.ndarray]] = []
-    for j, ks in _tooth_pairs_by_pinion(g).items():
-        chains = [_rack_chains(g, k) for k in ks]
-        mask = _active(g, j, max(c[5] for c in chains), phis)
-        idx = np.flatnonzero(mask)
-        if idx.size:
-            rho, gam = g.pinion_contact_polygon_polar(j)
-            ang = gam[None, :] + g.pinion_tooth_angle(j, phis[idx])[:, None]
-            px = rho * np.sin(ang)
-            py = g.centre_to_datum_mm - rho * np.cos(ang)
-            bx = np.concatenate([px[:, 1:], px[:, :1]], axis=1)
-            by = np.concatenate([py[:, 1:], py[:, :1]], axis=1)
-            dy = by - py
-            flat = dy == 0.0
-            inv_dy = 1.0 / np.where(flat, 1.0, dy)
-            slope_x = (bx - px) * inv_dy
-            y_min, y_max = py.min(axis=1), py.max(axis=1)
-        for k, (left, right, left_flank, right_flank, y0, top) in zip(ks, chains, strict=True):
-            pairs.append((j, k))
-            out = [np.full(phis.shape, np.nan) for _ in range(4 if flanks else 2)]
-            rows.append(out)
-            if not idx.size:
-                continue
-            overlap = (y_min <= top) & (y_max >= y0)
-            if not overlap.any():
-                continue
-            if flanks:
-                found = [_offsets(px, py, flat, inv_dy, slope_x, c) for c in (left_flank, right_flank)]
-            else:
-                found = [(_offsets(px, py, flat, inv_dy, slope_x, right, want_hi=False)[0],
-                          _offsets(px, py, flat, inv_dy, slope_x, left, want_lo=False)[1])]
-            for n, (lo_m, hi_m) in enumerate(found):
-                ok = overlap & np.isfinite(hi_m) & np.isfinite(lo_m)
-                out[2 * n][idx[ok]] = lo_m[ok]
-                out[2 * n + 1][idx[ok]] = hi_m[ok]
-    shape = (len(pairs), phis.size)
-    arrays = [np.array([r[n] for r in rows]).reshape(shape) for n in range(4 if flanks else 2)]
+    pairs, whole, left, right = all_intervals(g, phis)
     if flanks:
-        return pairs, (arrays[0], arrays[1]), (arrays[2], arrays[3])
-    return pairs, arrays[0], arrays[1]
+        return pairs, left, right
+    return pairs, whole[0], whole[1]
 
 
 def push_intervals(g: RackPinionGeometry, phis, direction: int) -> tuple[list[tuple[int, int]], np.ndarray, np.ndarray]:
@@ -278,8 +299,7 @@ def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float 
     up), each refined by bisection between grid angles."""
     phis = towing_grid(max_angle_deg, step_deg, extra_deg)
     # every interval once on the grid: left flanks push the forward swing, right flanks the return
-    pairs, (left_lo, left_hi), (right_lo, right_hi) = overlap_intervals(g, phis, flanks=True)
-    _, full_lo, full_hi = overlap_intervals(g, phis)
+    pairs, (full_lo, full_hi), (left_lo, left_hi), (right_lo, right_hi) = all_intervals(g, phis)
     # angle 0: tight mesh, rack tooth 0 centred
     fwd = sweep(g, phis, 0.0, +1, (pairs, left_lo, left_hi, full_lo, full_hi))
     end = float(fwd.travel_mm[-1])

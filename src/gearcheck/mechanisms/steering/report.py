@@ -1,5 +1,5 @@
 """The steering report: the paper vs model vs mesh table, the towing and power-mode plots and the
-findings in words, from the sweep's outcome."""
+notes in words, from the sweep's outcome."""
 
 from __future__ import annotations
 
@@ -45,9 +45,11 @@ def _value(x: float) -> float | None:
 
 
 def _comparisons(P: dict, data: SteeringSweep) -> list[Comparison]:
+    """The rows at 3 decimals (0.001° and 1 µm; a deviation in mm at 4)."""
     rows = _rows(P, data)
     return [dataclasses.replace(c, model=None if c.model is None else _value(c.model),
-                                geometry=None if c.geometry is None else _value(c.geometry)) for c in rows]
+                                geometry=None if c.geometry is None else _value(c.geometry),
+                                digits=4 if "deviation" in c.label else 3) for c in rows]
 
 
 def _drive_note(data: SteeringSweep, mode: str) -> str:

@@ -51,13 +51,25 @@ def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
                    f"−{_num(re[1])}° (free at {_num(bracket[0], 6)}°, touching at {_num(bracket[1], 6)}°)",
                    _finite({"min_signed_clearance_mm": min(ret), "contact_tolerance_mm": tol,
                             "plus_reengage_deg": re[0], "minus_reengage_deg": re[1]}),
-                   swept + "; the pick-up bracketed by bisection on the pinion angle"),
+                   swept + "; the pick-up bracketed by bisection on the pinion angle",
+                   shortfall=_clearance_shortfall(ret, tol) if not _ok(ret, lambda c: c >= -tol) else
+                   "the return swing does not pick the rack up within the swing (no re-engage angle)"),
         Verdict.of("no_interference_anywhere", "no interference at any pose (towing both ways, power mode)",
                    _ok(clear, lambda c: c >= -tol),
                    f"min signed clearance {_num(min(clear), 5)} mm ≥ −{tol:.3f} mm over {poses} poses",
-                   _finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol}), swept),
+                   _finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol}), swept,
+                   shortfall=_clearance_shortfall(clear, tol)),
         _mesh_agrees(data),
     ]
+
+
+def _clearance_shortfall(values: list[float], tol: float) -> str:
+    """An interference verdict's shortfall: the deepest overlap against the contact tolerance."""
+    least = min(values)
+    if not math.isfinite(least):
+        return "no clearance figure (a sweep direction gave none)"
+    return (f"min signed clearance {least:.5f} mm, required ≥ −{tol:.3f} mm (contact tolerance), overlapping "
+            f"{-least - tol:.5f} mm beyond it")
 
 
 def _mesh_agrees(data: SteeringSweep) -> Verdict:
@@ -85,7 +97,15 @@ def _mesh_agrees(data: SteeringSweep) -> Verdict:
         _finite({"max_deviation_mm": max(dev), "tolerance_mm": TOWING_CURVE_TOL_MM,
                  "max_handover_deviation_deg": worst, "handover_tolerance_deg": limit,
                  "max_flank_fit_residual_mm": fit, "flank_fit_tolerance_mm": FLANK_FIT_TOL_MM}),
-        "mesh sweep against the exact model (polyline push model; conjugate contact intervals of every pair)")
+        "mesh sweep against the exact model (polyline push model; conjugate contact intervals of every pair)",
+        shortfall="; ".join(
+            text for text, bad in (
+                (f"towing curve off by {_num(max(dev), 4)} mm, allowed ≤ {TOWING_CURVE_TOL_MM:g} mm",
+                 not _ok(dev, lambda d: d <= TOWING_CURVE_TOL_MM)),
+                (f"contact interval ends off by {_num(worst, 4)}°, allowed ≤ {limit:.4f}°",
+                 not (compared and worst <= limit)),
+                (f"mesh flank vertices {_num(fit * 1000.0, 5)} µm off their involutes, allowed ≤ "
+                 f"{FLANK_FIT_TOL_MM * 1000.0:g} µm", not _ok([fit], lambda r: r <= FLANK_FIT_TOL_MM))) if bad))
 
 
 def _continuous_drive(data: SteeringSweep, target: float) -> Verdict:
@@ -132,10 +152,12 @@ def _continuous_drive(data: SteeringSweep, target: float) -> Verdict:
                "plus_deg": plus["geom_continuous_angle_deg"], "minus_deg": minus["geom_continuous_angle_deg"],
                "geom_towing_plus_deg": plus["geom_towing_conjugate_end_deg"],
                "geom_towing_minus_deg": minus["geom_towing_conjugate_end_deg"]}
+    short = (f"continuous drive {_num(least)}° ({event.split(', ', 1)[-1]}), required ≥ {target:g}°"
+             + (f", short by {target - least:.3f}°" if math.isfinite(least) else ""))
     return Verdict.of(
         "continuous_drive",
         f"continuous drive (towing and power mode, every hand-over) to ≥ {target:g}° (targets.continuous_angle_deg)",
-        passed, measured, _finite(figures), evidence)
+        passed, measured, _finite(figures), evidence, shortfall=short)
 
 
 def _reach(plus: dict, minus: dict, key: str, end_key: str) -> str:
@@ -173,7 +195,9 @@ def _contact_ratio(params, eps: float) -> Verdict:
         math.isfinite(eps) and eps >= rule,
         f"ε = {_num(eps, 4)} at hS4 = {params.trim.hS4_mm:g} mm (rule {rule:g})",
         _finite({"contact_ratio": eps, "min_contact_ratio": rule, "hS4_mm": params.trim.hS4_mm}),
-        "analytical model (eqs 1-2: approach to the machined S4 corner, recess to the tip circle)")
+        "analytical model (eqs 1-2: approach to the machined S4 corner, recess to the tip circle)",
+        shortfall=f"ε = {_num(eps, 4)}, required ≥ {rule:g}"
+                  + (f", short by {rule - eps:.4f}" if math.isfinite(eps) else ""))
 
 
 def _moving(data: SteeringSweep) -> list[str]:
@@ -199,7 +223,9 @@ def _rack_stops(data: SteeringSweep, max_deg: float) -> Verdict:
             f"= {max_deg:g}°",
             _finite({"max_angle_deg": max_deg, "motion_last_degree_mm": last, "contact_tolerance_mm": tol}),
             "mesh sweep (rack pushed by the meshed teeth, both directions) and exact model (polyline push model): "
-            "either still moving decides")
+            "either still moving decides",
+            shortfall=f"the rack still moves at ±{max_deg:g}° ({', '.join(moving)}; {_num(last)} mm over the last "
+                      "degree), required: stopped before the end of the swing")
     dis = [plus["geom_disengage_angle_deg"], minus["geom_disengage_angle_deg"]]
     creep = [plus["geom_rack_motion_after_disengage_mm"], minus["geom_rack_motion_after_disengage_mm"]]
     return Verdict.of(
@@ -210,7 +236,9 @@ def _rack_stops(data: SteeringSweep, max_deg: float) -> Verdict:
         _finite({"plus_deg": dis[0], "minus_deg": dis[1], "max_angle_deg": max_deg,
                  "creep_mm": max(creep), "contact_tolerance_mm": tol}),
         "mesh sweep (rack pushed by the meshed teeth, both directions; the stop extrapolated to zero clearance "
-        "from the rack held one and two contact tolerances short)")
+        "from the rack held one and two contact tolerances short)",
+        shortfall=f"stops at +{_num(dis[0])}° / −{_num(dis[1])}°, required before {max_deg:g}°; moves "
+                  f"{_num(max(creep), 4)} mm after, allowed ≤ {tol:.3f} mm")
 
 
 def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
@@ -221,7 +249,8 @@ def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
                               "towing: no interference past the disengage", "warn",
                               "not checked: the rack is still moving at the end of the swing (no disengage within "
                               "towing.max_angle_deg; see rack_stops)", {},
-                              "mesh sweep: no pose past a disengage to check")
+                              "mesh sweep: no pose past a disengage to check",
+                              shortfall="not checked: no disengage within the towing swing (see the rack_stops claim)")
     past = [plus["min_clearance_past_disengage_mm"], minus["min_clearance_past_disengage_mm"]]
     shifts = [plus["graze_contact_shift_mm"], minus["graze_contact_shift_mm"]]
     return Verdict.of(
@@ -231,4 +260,5 @@ def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
         f"{_num(max(shifts), 5)} mm of rack shift away",
         _finite({"min_signed_clearance_mm": min(past), "contact_tolerance_mm": tol,
                  "contact_shift_mm": max(shifts)}),
-        swept + "; the closest pose past the stop confirmed on the exact B-rep")
+        swept + "; the closest pose past the stop confirmed on the exact B-rep",
+        shortfall=_clearance_shortfall(past, tol))

@@ -36,6 +36,11 @@ class TrackDrive(Mechanism):
     def assembly(self, params: TrackParams) -> Assembly:
         return track_assembly(params)
 
+    def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
+        from gearcheck.mechanisms.track.display import display_frames
+
+        return display_frames(params, assembly)
+
     def smallest_clearance(self, params: TrackParams) -> Clearance | None:
         from gearcheck.mechanisms.track.clearance import least_clearance
 

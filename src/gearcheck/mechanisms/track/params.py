@@ -27,6 +27,10 @@ def _f(lo=None, hi=None, *, gt=None, lt=None, unit="", description=""):
     return Field(ge=lo, le=hi, gt=gt, lt=lt, description=description, json_schema_extra={"unit": unit})
 
 
+# Rows that leave less than this (mm) for each groove fill the track: a groove, which must be
+# wider than 0, has no bound left to meet, so the tooth width is the field to change.
+GROOVE_ROOM_MIN_MM = 1e-6
+
 class Robot(Section):
     mass_kg: float = _f(gt=0, hi=100_000, unit="kg", description="total mass incl. payload (paper: 150 kg)")
     speed_m_s: float = _f(gt=0, hi=50, unit="m/s", description="design travel speed v")
@@ -183,13 +187,14 @@ class Params(Section):
 
     def _width_error(self, total: float) -> ParamError:
         """Rows and grooves wider than the track: the middle groove's own bound when the rows
-        alone fit, else the tooth width's."""
+        alone leave room for grooves, else the tooth width's (rows that fill the track to a
+        rounding leave the grooves, which must be > 0, no bound to meet)."""
         s, width = self.sprocket, self.chain.track_width_mm
         n, bf, groove = s.tooth_rows, s.tooth_width_mm, s.middle_groove_width_mm
         grooves = f"{n - 1} groove{'s' if n > 2 else ''}"
         parts = f"{n} rows and {grooves} span" if n > 1 else "the tooth row spans"
         span = f"{parts} {total:g} mm, more than the track width {width:g} mm"
-        if n > 1 and n * bf < width:
+        if n > 1 and (width - n * bf) / (n - 1) > GROOVE_ROOM_MIN_MM:  # the rows leave room for grooves
             def fits(v: float) -> bool:
                 return n * bf + (n - 1) * v <= width
 

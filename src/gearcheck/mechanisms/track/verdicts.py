@@ -42,26 +42,40 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
              if collisions else f"FCL collide false at all {len(angles)}×{model.wrap.links} link poses; ")
     kind = ("a positive clearance beyond the bound" if min_sleeve.value > bound
             else "within the bound: a contact, not a resolved clearance")
+    least_exact = min(ex_min_sleeve.value, ex_min_plate.value)
+    interference = (f"{collisions} colliding link poses" if collisions and resolved else "no mesh collision") + (
+        f"; the exact 2-D model overlaps by {-least_exact:.4f} mm, required ≥ 0" if exact_penetration else "")
+    lo, hi = model.required_gap_min_mm, model.required_gap_max_mm
+    gap_short = (f"seated tip gap {seated_gap.value:.4f} mm, required {lo:g}–{hi:g} mm, short by "
+                 f"{lo - seated_gap.value:.4f} mm" if rounded(seated_gap.value) < lo else
+                 f"seated tip gap up to {d.seated_gap_max:.4f} mm, required {lo:g}–{hi:g} mm, over by "
+                 f"{d.seated_gap_max - hi:.4f} mm")
+    proof_short = "; ".join(_proof_shortfall(name, p, bound, d.contact_tol)
+                            for name, p in (("tip gap", gap_proof), ("seat", sleeve_proof)) if not p.holds(bound))
     return [
         Verdict.of("no_interference", "no interference between sprocket and links over the sweep", no_interference,
                    clash + f"min tooth–sleeve {min_sleeve.value:.4f} mm ({kind}; exact "
                    f"{ex_min_sleeve.value:.4f}), min tip–plate {min_plate.value:.4f} mm; bound {bound:.3f} mm",
                    {"collisions": collisions, "min_tooth_sleeve_mm": min_sleeve.value,
                     "exact_min_tooth_sleeve_mm": ex_min_sleeve.value, "min_tip_plate_mm": min_plate.value,
-                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}, evidence=on_mesh),
+                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}, evidence=on_mesh,
+                   shortfall=interference),
         Verdict.of("seated_tip_gap_in_window", "seated-link tip gap inside the paper's window", gap_in_window,
                    f"{seated_gap.value:.4f}–{d.seated_gap_max:.4f} mm over {int(d.links_seated.sum())} seated link "
                    f"poses (template {model.tip_gap_mm:g}), window {model.required_gap_min_mm:g}–"
                    f"{model.required_gap_max_mm:g} mm; bound {bound:.3f} mm",
                    {"seated_tip_gap_mm": seated_gap.value, "seated_tip_gap_max_mm": d.seated_gap_max,
                     "window_min_mm": model.required_gap_min_mm, "window_max_mm": model.required_gap_max_mm},
-                   evidence="mesh sweep (seated links), proven from both sides; exact 2-D model agrees"),
+                   evidence="mesh sweep (seated links), proven from both sides; exact 2-D model agrees",
+                   shortfall=gap_short),
         Verdict.of("min_tip_plate_distance", "tip-to-plate distance over the sweep ≥ the paper's minimum",
                    min_plate_ok,
                    f"min {min_plate.value:.4f} mm at {d.where(min_plate)}, limit ≥ {model.required_gap_min_mm:g} mm; "
                    f"bound {bound:.3f} mm",
                    {"min_tip_plate_mm": min_plate.value, "limit_mm": model.required_gap_min_mm},
-                   evidence="mesh sweep (every link pose); exact 2-D model agrees"),
+                   evidence="mesh sweep (every link pose); exact 2-D model agrees",
+                   shortfall=f"least tip–plate distance {min_plate.value:.4f} mm, required ≥ {lo:g} mm, short by "
+                             f"{lo - min_plate.value:.4f} mm"),
         Verdict.of("contact_proven", "clearances proven from both sides (free at −tol, contact at +tol)", proofs_hold,
                    f"tip gap: contact at {gap_proof.contact_mm:.5f} mm vs measured {gap_proof.measured_mm:.5f}; "
                    f"seat: contact at {sleeve_proof.contact_mm:.5f} mm vs measured {sleeve_proof.measured_mm:.5f}; "
@@ -69,15 +83,27 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                    {"tip_gap_contact_mm": gap_proof.contact_mm, "tip_gap_measured_mm": gap_proof.measured_mm,
                     "seat_contact_mm": sleeve_proof.contact_mm, "seat_measured_mm": sleeve_proof.measured_mm,
                     "tolerance_mm": d.contact_tol, "bound_mm": bound},
-                   evidence="mesh sweep (FCL: pushed by the gap ∓ tolerance)"),
+                   evidence="mesh sweep (FCL: pushed by the gap ∓ tolerance)", shortfall=proof_short),
         *_wear_verdicts(d),
         Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with the exact 2-D model at every pose and link",
                    agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm"
                    + ("" if d.worn_mesh is None else f" (worn chain: {worn_dev:.4f} mm)") + f", bound {bound:.3f} mm",
                    {"max_mesh_deviation_mm": d.max_dev, "bound_mm": bound,
                     **({} if d.worn_mesh is None else {"worn_max_mesh_deviation_mm": worn_dev})},
-                   evidence="mesh sweep against the exact 2-D model"),
+                   evidence="mesh sweep against the exact 2-D model",
+                   shortfall=f"max |mesh − exact| {max(d.max_dev, worn_dev):.4f} mm, allowed ≤ {bound:.4f} mm, over by "
+                             f"{max(d.max_dev, worn_dev) - bound:.4f} mm"),
     ]
+
+
+def _proof_shortfall(name: str, proof, bound: float, tol: float) -> str:
+    """Why a contact proof does not hold, in words."""
+    if not proof.free_at_minus:
+        return f"{name}: already colliding {tol:.3f} mm short of the measured {proof.measured_mm:.5f} mm, required free"
+    if not proof.touching_at_plus:
+        return f"{name}: still free {tol:.3f} mm beyond the measured {proof.measured_mm:.5f} mm, required contact"
+    return (f"{name}: contact at {proof.contact_mm:.5f} mm vs measured {proof.measured_mm:.5f} mm, off by "
+            f"{abs(proof.contact_mm - proof.measured_mm):.5f} mm, allowed ≤ {bound:.4f} mm")
 
 
 def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
@@ -91,6 +117,11 @@ def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
     mesh = ("" if m is None else
             f"; mesh sweep of the worn chain: {m.collisions} collisions, min tooth–sleeve {m.min_sleeve_mm:.4f} mm, "
             f"min tip–plate {m.min_plate_mm:.4f} mm over {m.poses}×{d.model.wrap.links} link poses")
+    if not w.ok:
+        short = (f"declared wear {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % (a link first fails to seat), "
+                 f"over by {100 * (w.declared - w.limit):.4f} %")
+    else:
+        short = f"the worn chain's mesh sweep collides at {m.collisions if m is not None else 0} poses, required none"
     return [Verdict.of(
         "chain_wear_within_limit", "declared chain wear ≤ the elongation at which a link first fails to seat",
         w.ok and (m is None or m.collisions == 0),
@@ -99,4 +130,5 @@ def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
         f"(exact 2-D model){mesh}",
         {"wear_declared_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
          "wear_limit_mode": w.mode_code},
-        evidence="exact model (2-D section, bisection on the elongation); mesh sweep at the declared wear")]
+        evidence="exact model (2-D section, bisection on the elongation); mesh sweep at the declared wear",
+        shortfall=short)]

@@ -1,0 +1,456 @@
+"""What the command line shows, made here and printed by :mod:`gearcheck.cli` (the only module
+that prints): the calc table, the verdicts, the one-line pointers, and the JSON object of a build
+or a check.
+
+Two looks, one content. On a terminal: tables, coloured PASS / WARN / FAIL, everything wrapped to
+the terminal's width (with ``NO_COLOR`` set: the same layout without escape codes). Piped or
+redirected: plain text, no escape codes, no trailing blanks, nothing wrapped: one verdict per line
+and the calc table as wide as its longest note, so that ``grep`` finds a verdict and its
+measurement on one line (``fold -s`` or ``less -S`` to read it narrow).
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import math
+import os
+import re
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from rich.console import Console, RenderableType
+
+    from gearcheck.figures import Figure
+    from gearcheck.pipeline import BuildRun, CheckRun
+    from gearcheck.results import CheckResult
+
+UNBOUNDED = 4000  # the width of a "line" when nothing is wrapped (not a terminal)
+NOTE_MIN = 16  # the calc table's notes wrap down to this width before its quantities do
+NOTE_COLUMN_MIN = 30  # narrower than this, each note goes on its own line under its quantity
+NOTE_INDENT = 3
+MIN_WIDTH = 40  # narrower terminals are drawn at this width (the terminal wraps the rest)
+LEVEL_WORD = {"pass": "PASS", "warn": "WARN", "fail": "FAIL"}
+LEVEL_STYLE = {"pass": "bold black on green", "warn": "bold black on yellow", "fail": "bold white on red"}
+
+
+@dataclass(frozen=True)
+class Screen:
+    """Where the output goes: a terminal or not, colours or not, the width to wrap at (None: no
+    wrapping)."""
+
+    tty: bool
+    color: bool
+    width: int | None
+
+    @classmethod
+    def of(cls, stream: Any, environ: Mapping[str, str] = os.environ) -> Screen:
+        """The terminal's width when ``stream`` is one (its real size: a ``COLUMNS`` left in the
+        environment by a parent's readline is no guide), else no wrapping."""
+        try:
+            tty = bool(stream.isatty())
+        except (AttributeError, ValueError):
+            tty = False
+        width = None
+        if tty:
+            try:
+                width = max(os.get_terminal_size(stream.fileno()).columns or 80, MIN_WIDTH)
+            except (AttributeError, ValueError, OSError):
+                width = 80
+        color = tty and not environ.get("NO_COLOR") and environ.get("TERM") != "dumb"
+        return cls(tty, color, width)
+
+
+# ------------------------------------------------------------------------------------------
+# Help
+
+DESCRIPTION = """\
+gearcheck turns a parameter file (TOML template) into the design figures, CAD and an
+interference proof of a gear mechanism.
+
+Mechanisms: {mechanisms} (one template each in templates/:
+  zhurong_differential.toml   bevel-gear differential, cold backlash and shims
+  eod_track_drive.toml        roller-chain track sprocket, every other tooth engaging
+  nose_wheel_steering.toml    trimmed rack and pinion, continuous drive and disengage angles)
+
+Examples:
+  gearcheck calc templates/zhurong_differential.toml
+  gearcheck calc templates/zhurong_differential.toml --set operating.cold_C=-130
+  gearcheck calc templates/nose_wheel_steering.toml --set trim.min_contact_ratio=1.3 --json
+  gearcheck check templates/eod_track_drive.toml --jobs 2 --open
+  gearcheck check templates/eod_track_drive.toml --json > run.json
+  gearcheck build --all --out out
+  gearcheck schema track > track.schema.json
+  gearcheck demo --open
+
+Output: tables and coloured PASS / WARN / FAIL on a terminal, wrapped to its width (NO_COLOR:
+the same without colours); plain text when piped, not wrapped: one verdict per line, for grep.
+Progress bars with totals and the time left go to stderr when it is a terminal.
+Exit codes: 0 no verdict fails (warnings included), 1 a verdict fails, 2 bad input, 130 / 143
+interrupted.
+"""
+
+TOL_HELP = ("absolute chordal tolerance of the meshes in mm, used as given (default per mechanism: {defaults}, "
+            "refined before meshing so that the two meshes' error bounds together stay within 1/10 of the "
+            "smallest clearance the design asks to decide, from its exact model; where a mesh cannot resolve "
+            "it, the exact model and the exact B-rep decide, and the report says so)")
+
+CHECK_EXAMPLES = """\
+Examples:
+  gearcheck check templates/eod_track_drive.toml
+  gearcheck check templates/zhurong_differential.toml --set shim.thickness_mm=0.15 --out out/shim015
+  gearcheck check templates/eod_track_drive.toml --json | jq '.verdicts[] | [.level, .label]'
+  gearcheck check out/eod_track_drive/params.toml --out out/again   (reproduces a run)
+  gearcheck check --all --jobs 2 --open"""
+
+BUILD_EXAMPLES = """\
+Examples:
+  gearcheck build templates/nose_wheel_steering.toml --open
+  gearcheck build templates/eod_track_drive.toml --tol 0.005 --json
+  gearcheck build --all --out out --jobs 3"""
+
+
+class HelpFormatter(argparse.HelpFormatter):
+    """Fills in the per-mechanism tolerances only when help is shown (it imports the mechanisms);
+    wraps prose paragraphs and keeps those with indented lines (examples, lists) as written."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        text = super()._get_help_string(action)
+        if action.dest == "tol" and text is not None:
+            from gearcheck.mechanism import all_mechanisms
+
+            defaults = ", ".join(f"{m.name} {m.mesh_tol_mm:g}" for m in all_mechanisms())
+            return text.replace("{defaults}", defaults)
+        return text
+
+    def _fill_text(self, text: str, width: int, indent: str) -> str:
+        paragraphs = []
+        for para in text.split("\n\n"):
+            if any(line.startswith("  ") for line in para.splitlines()):
+                paragraphs.append("\n".join(indent + line for line in para.splitlines()))
+            else:
+                paragraphs.append(super()._fill_text(para, width, indent))
+        return "\n\n".join(paragraphs)
+
+
+
+def _box(screen: Screen):
+    from rich import box
+
+    if screen.color:
+        return box.SIMPLE_HEAD
+    # the header underlined with ASCII dashes, columns apart by blanks (as the calc.txt file)
+    return box.Box("    \n    \n -  \n    \n    \n    \n    \n    \n", ascii=True)
+
+
+_TRAILING = re.compile(r"\s+((?:\x1b\[[0-9;]*m)*)$")  # blanks at a line's end, before any closing style codes
+
+
+def text(screen: Screen, *renderables: RenderableType) -> str:
+    """The renderables as the screen shows them: escape codes only with colour, each line's
+    trailing blanks cut."""
+    from rich.console import Console
+
+    out = io.StringIO()
+    console: Console = Console(file=out, width=screen.width or UNBOUNDED, force_terminal=screen.color,
+                               color_system="auto" if screen.color else None, no_color=not screen.color,
+                               highlight=False, markup=False, emoji=False, legacy_windows=False,
+                               force_jupyter=False, force_interactive=False, _environ={})
+    for r in renderables:
+        console.print(r, crop=screen.width is not None, soft_wrap=screen.width is None)
+    return "\n".join(_TRAILING.sub(r"\1", line) for line in out.getvalue().splitlines())
+
+
+def _fmt(value: float | None, digits: int) -> str:
+    if value is None:
+        return ""
+    return f"{value:.{digits}f}" if math.isfinite(value) else str(value)
+
+
+def calc_view(title: str, figures: list[Figure], screen: Screen) -> list[RenderableType]:
+    """The analytical figures as a table: quantity, value, unit, the paper's value, the
+    difference, and the note saying why they differ (the note column wraps on a terminal)."""
+    from rich.padding import Padding
+    from rich.table import Table
+    from rich.text import Text
+
+    rows = []
+    for f in figures:
+        diff = f.difference
+        rows.append((f.label, _fmt(f.value, f.digits), f.unit, _fmt(f.paper, f.digits),
+                     "" if diff is None else f"{diff:+.{f.digits}f}", f.note))
+    heads = ("quantity", "value", "unit", "paper", "diff", "note")
+    longest = [max(len(r[i]) for r in [heads, *rows]) for i in range(6)]
+    quantity_w = note_w = None
+    notes_under = False
+    if screen.width is not None:  # the quantity keeps its width while the notes wrap
+        room = screen.width - sum(longest[1:5]) - 15  # 15: padding and dividers of six columns
+        quantity_w = min(longest[0], max(12, room - NOTE_MIN))
+        note_w = max(NOTE_MIN, min(longest[5], room - quantity_w))
+        # too narrow for a note column worth reading: each note on its own line under its quantity
+        notes_under = note_w < NOTE_COLUMN_MIN and longest[5] > note_w
+        if notes_under:
+            quantity_w = min(max(longest[0], min(longest[5] + NOTE_INDENT, room + 3)), max(12, room + 3))
+    table = Table(box=_box(screen), show_edge=False, pad_edge=False, header_style="bold", padding=(0, 1))
+    table.add_column("quantity", width=quantity_w, overflow="fold")
+    table.add_column("value", justify="right", no_wrap=True, style="bold")
+    table.add_column("unit", no_wrap=True)
+    table.add_column("paper", justify="right", no_wrap=True, style="cyan")
+    table.add_column("diff", justify="right", no_wrap=True, style="yellow")
+    if not notes_under:
+        table.add_column("note", width=note_w, overflow="fold", style="dim")
+    for row in rows:
+        if not notes_under:
+            table.add_row(*row)
+            continue
+        table.add_row(*row[:5])
+        if row[5]:
+            table.add_row(Padding(Text(row[5], style="dim italic"), (0, 0, 0, NOTE_INDENT)), "", "", "", "")
+    return [Text(title, style="bold"), table]
+
+
+def badge(level: str, screen: Screen) -> Any:
+    """PASS / WARN / FAIL: on a coloured background on a terminal, the bare word otherwise."""
+    from rich.text import Text
+
+    word = LEVEL_WORD[level]
+    return Text(f" {word} ", LEVEL_STYLE[level]) if screen.color else Text(word)
+
+
+def _headline(result: CheckResult, name: str, folder: Path, screen: Screen) -> Any:
+    from rich.text import Text
+
+    passed = sum(v.passed for v in result.verdicts)
+    warned = sum(v.level == "warn" for v in result.verdicts)
+    line = Text()
+    line.append_text(badge(result.level, screen))
+    line.append(f" {name}: {passed}/{len(result.verdicts)} verdicts pass"
+                f"{f', {warned} with a warning' if warned else ''}; report {folder / 'report.html'}")
+    return line
+
+
+def verdicts_view(result: CheckResult, name: str, folder: Path, screen: Screen) -> list[RenderableType]:
+    """The design's level, then one entry per verdict: PASS / WARN / FAIL, what was checked,
+    what was measured, the evidence that decided it. Wrapped under its level word on a terminal;
+    one line per verdict otherwise."""
+    from rich.table import Table
+    from rich.text import Text
+
+    out: list[RenderableType] = [_headline(result, name, folder, screen)]
+    if screen.width is None:
+        for v in result.verdicts:
+            line = Text("  ")
+            line.append_text(badge(v.level, screen))
+            line.append(f"  {v.label}: {v.measured}" + (f" [{v.evidence}]" if v.evidence else ""))
+            out.append(line)
+        return out
+    grid = Table.grid(padding=(0, 2, 0, 0), pad_edge=False)
+    grid.add_column(no_wrap=True)
+    grid.add_column(overflow="fold")
+    for i, v in enumerate(result.verdicts):
+        body = Text(v.label, style="bold")
+        body.append(f"\n{v.measured}")
+        if v.evidence:
+            body.append(f"\nevidence: {v.evidence}", style="dim")
+        if i:
+            grid.add_row("", "")
+        grid.add_row(badge(v.level, screen), body)
+    return [*out, _indented(grid)]
+
+
+def _indented(renderable: RenderableType) -> RenderableType:
+    from rich.padding import Padding
+
+    return Padding(renderable, (0, 0, 0, 2))
+
+
+def calc_pointer(figures: list[Figure], path: Path) -> str:
+    """One line in place of the calc table: how many figures, how many beside the paper's, where
+    the table is."""
+    paper = sum(f.paper is not None for f in figures)
+    return f"{len(figures)} figures ({paper} beside the paper's values), table in {path}"
+
+
+def _size(n: float) -> str:
+    for unit in ("B", "kB", "MB", "GB"):
+        if n < 1000 or unit == "GB":
+            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+        n /= 1000
+    return f"{n:.1f} GB"
+
+
+def files_line(folder: Path, files: Iterable[Path], parts: int) -> str:
+    """"wrote DIR/ (size): N parts; report.html, ..., 2 PNG, 13 STL" for a build or a check."""
+    files = [p for p in files if p.is_file()]
+    first = ("report.html", "summary.json", "sweep.csv")
+    names = sorted((p.name for p in files), key=lambda n: (first.index(n) if n in first else len(first), n))
+    counted = {ext: sum(n.endswith(f".{ext.lower()}") for n in names) for ext in ("PNG", "STL")}
+    shown = [n for n in names if not n.endswith((".png", ".stl"))]
+    shown += [f"{k} {ext}" for ext, k in counted.items() if k]
+    total = sum(p.stat().st_size for p in files)
+    return f"wrote {folder}/ ({_size(total)}): {parts} parts; {', '.join(shown)}"
+
+
+# ------------------------------------------------------------------------------------------
+# JSON (check --json, build --json)
+
+
+def _finite(figures: Mapping[str, Any]) -> dict[str, float]:
+    return {k: float(v) for k, v in figures.items()
+            if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)}
+
+
+def _files(paths: Iterable[Path]) -> list[dict[str, Any]]:
+    return [{"file": p.name, "bytes": p.stat().st_size} for p in paths if p.is_file()]
+
+
+def _mesh(manifest: Mapping[str, Any]) -> dict[str, Any]:
+    plan = manifest.get("mesh_tolerance", {})
+    out: dict[str, Any] = {
+        "chordal_tolerance_mm": float(manifest["chordal_tolerance_mm"]),
+        "parts": len(manifest["parts"]),
+        "triangles": int(sum(p["triangles"] for p in manifest["parts"])),
+    }
+    for key in ("requested_tol_mm", "refined", "explicit", "smallest_clearance_mm", "smallest_clearance"):
+        value = plan.get(key)
+        if value is not None and (not isinstance(value, float) or math.isfinite(value)):
+            out[key] = value
+    return out
+
+
+def build_json(run: BuildRun) -> dict[str, Any]:
+    """What ``gearcheck build --json`` prints for one template (plain data: it travels back from
+    a worker process when --all builds several)."""
+    manifest = run.manifest
+    return {
+        "mechanism": run.design.mechanism,
+        "name": run.design.name,
+        "template": run.design.source,
+        "folder": str(Path(run.folder).absolute()),
+        "mesh": _mesh(manifest),
+        "parts": [{"name": p["name"], "material": p["material"], "triangles": p["triangles"],
+                   "brep_volume_mm3": p["brep_volume_mm3"], "mesh_error_bound_mm": p["mesh_error_bound_mm"]}
+                  for p in manifest["parts"]],
+        "files": _files(run.files),
+    }
+
+
+def check_json(run: CheckRun) -> dict[str, Any]:
+    """What ``gearcheck check --json`` prints for one template: the design's level, each verdict
+    (level, what was measured, the deciding numbers, the evidence), the key figures (paper vs
+    model vs geometry, the exact confirmation), the mesh, and every file written with its size."""
+    result, build = run.result, run.build
+    counts = {level: sum(v.level == level for v in result.verdicts) for level in LEVEL_WORD}
+    comparisons = []
+    for c in result.comparisons:
+        row: dict[str, Any] = {"label": c.label, "unit": c.unit}
+        for key in ("paper", "model", "exact", "geometry"):
+            value = getattr(c, key)
+            if value is not None and math.isfinite(value):
+                row[key] = float(value)
+        if c.note:
+            row["note"] = c.note
+        comparisons.append(row)
+    return {
+        "mechanism": build.design.mechanism,
+        "name": build.design.name,
+        "template": build.design.source,
+        "folder": str(Path(run.folder).absolute()),
+        "level": result.level,
+        "passed": bool(result.passed),
+        "counts": counts,
+        "verdicts": [{"name": v.name, "label": v.label, "level": v.level, "measured": v.measured,
+                      "evidence": v.evidence, "figures": _finite(v.figures)} for v in result.verdicts],
+        "figures": comparisons,
+        "confirmations": [{"label": c.label, "parts": c.parts, "agrees": bool(c.agrees),
+                           **_finite({"mesh_mm": c.mesh_mm, "brep_mm": c.brep_mm, "bound_mm": c.bound_mm,
+                                      "overlap_mm3": c.overlap_mm3})} for c in result.confirmations],
+        "mesh": _mesh(build.manifest),
+        "files": _files(run.files),
+    }
+
+
+# ------------------------------------------------------------------------------------------
+# Progress on a terminal
+
+
+def clock(seconds: float) -> str:
+    """m:ss, or h:mm:ss from an hour on."""
+    s = int(round(seconds))
+    return f"{s // 3600}:{s // 60 % 60:02d}:{s % 60:02d}" if s >= 3600 else f"{s // 60}:{s % 60:02d}"
+
+
+def _without_size() -> dict[str, str]:
+    """The environment less COLUMNS / LINES (a parent's readline leaves them stale): the bars
+    follow the terminal's real size."""
+    return {k: v for k, v in os.environ.items() if k not in ("COLUMNS", "LINES")}
+
+
+class Bars:
+    """The pipeline's progress factory (``progress(desc, total, unit)``) on a terminal: one rich
+    display on stderr, a line per stage with its count out of the total, the percentage, the time
+    taken and the time left. ``wait(desc)`` shows a stage the pipeline reports no progress for
+    (the plan and the solids before meshing) until the next bar begins. Use it as a context."""
+
+    def __init__(self, stream: Any = None) -> None:
+        import sys
+
+        from rich.console import Console
+        from rich.progress import BarColumn, Progress, SpinnerColumn, TaskProgressColumn, TextColumn, TimeElapsedColumn
+
+        self.progress = Progress(
+            SpinnerColumn(finished_text="✓"), TextColumn("{task.description}", markup=False),
+            BarColumn(bar_width=None), TextColumn("{task.fields[count]}", markup=False), TaskProgressColumn(),
+            TimeElapsedColumn(), TextColumn("{task.fields[eta]}", style="cyan", markup=False),
+            console=Console(file=stream or sys.stderr, highlight=False, markup=False, emoji=False,
+                            _environ=_without_size()),
+            redirect_stdout=True, redirect_stderr=True, expand=True, refresh_per_second=8)
+        self.pending: Any = None
+
+    def __enter__(self) -> Bars:
+        self.progress.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._end_pending()
+        self.progress.stop()
+
+    def wait(self, desc: str) -> None:
+        self._end_pending()
+        self.pending = self.progress.add_task(desc, total=None, count="", eta="")
+
+    def _end_pending(self) -> None:
+        if self.pending is not None:
+            self.progress.update(self.pending, total=1, completed=1)
+            self.progress.stop_task(self.pending)
+            self.pending = None
+
+    @contextlib.contextmanager
+    def __call__(self, desc: str, total: int | None = None, unit: str = "") -> Iterator[_Task]:
+        self._end_pending()
+        bar = _Task(self.progress, self.progress.add_task(desc, total=total, count="", eta=""), unit)
+        bar.update(0)
+        try:
+            yield bar
+        finally:
+            self.progress.update(bar.task, eta="")
+            self.progress.stop_task(bar.task)
+
+
+class _Task:
+    """One bar: ``update(n)`` advances it and refreshes its count and time left."""
+
+    def __init__(self, progress: Any, task: Any, unit: str):
+        self.progress, self.task, self.unit = progress, task, unit
+
+    def update(self, n: int = 1) -> None:
+        self.progress.advance(self.task, n)
+        t = self.progress.tasks[self.task]
+        total = "?" if t.total is None else f"{t.total:g}"
+        left = t.time_remaining
+        self.progress.update(self.task, count=f"{t.completed:g}/{total} {self.unit}".rstrip(),
+                             eta="" if left is None or t.finished else f"eta {clock(left)}")
