@@ -4,6 +4,7 @@ variants are counted, and the folder is one transaction."""
 
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -73,7 +74,7 @@ def test_closed_form_probability_and_rejections(tmp_path):
     """Seating radius ~ N(4.1, 0.05), validation allows the ISO 606 range 4.040–4.178 mm: the
     rejected count is exactly the number of draws outside it, and P(r > 4.15 | valid) matches the
     truncated normal's closed form within the Wilson interval."""
-    res = gearcheck.study(write(tmp_path, samples=1024), jobs=1)
+    res = gearcheck.study(write(tmp_path, samples=1024), jobs=1, out=tmp_path / "study")
     s = res.summary
     r = np.asarray(res.table.column("in.sprocket.seating_radius_mm").to_numpy())
     assert s["rejected"] == int(np.sum((r > 4.178) | (r < 4.04))) > 0
@@ -84,6 +85,11 @@ def test_closed_form_probability_and_rejections(tmp_path):
     assert f["ci95_low"] <= exact <= f["ci95_high"]
     assert f["probability"] == pytest.approx(exact, abs=0.02)
     assert f["variants"] == s["valid"] == 1024 - s["rejected"]
+    # the report reads at phone width: viewport, plots that scale to the page (no fixed pixel width)
+    page = (tmp_path / "study" / "report.html").read_text()
+    svgs = re.findall(r"<svg[^>]*>", page)
+    assert "name='viewport'" in page and svgs
+    assert all("width=\"100%\"" in t and "viewBox" in t and "pt\"" not in t for t in svgs)
 
 
 def test_zero_width_distributions_reproduce_calc_exactly(tmp_path):

@@ -75,7 +75,7 @@ def _histograms(spec: StudySpec, summary: dict, tab) -> list[str]:
         ax.grid(True, alpha=0.3)
         if limits.get(key):
             ax.legend(fontsize=8)
-        out.append(f"<div class='plot'>{figure_svg(fig)}</div>")
+        out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
     return out
 
 
@@ -103,7 +103,7 @@ def _failure_curves(spec: StudySpec, summary: dict, tab) -> list[str]:
         for ax in list(axes.flat)[len(inputs):]:
             ax.axis("off")
         fig.suptitle(f"P({name}) against each input (equal-count bins)", fontsize=10)
-        out.append(f"<div class='plot'>{figure_svg(fig)}</div>")
+        out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
     return out
 
 
@@ -127,7 +127,7 @@ def _paper_vs_exact(tab) -> list[str]:
         ax.set_title(f"{key}: {int(both.sum())} variants; mean difference {float(np.mean(e[both] - a[both])):.4g}")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
-        out.append(f"<div class='plot'>{figure_svg(fig)}</div>")
+        out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
     return out
 
 
