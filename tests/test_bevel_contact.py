@@ -80,7 +80,7 @@ def test_sample_filter_never_drops_a_sample_that_counts():
     bigs, smalls = _pairs(12)
     poses_b = np.stack([b.pose for b in bigs])
     poses_s = np.stack([s.pose for s in smalls])
-    inv_b, inv_s = bc._rigid_inverse(poses_b), bc._rigid_inverse(poses_s)
+    inv_b, inv_s = bc.rigid_inverse(poses_b), bc.rigid_inverse(poses_s)
     scales_b, scales_s = np.ones(12), np.array([s.scale for s in smalls])
     t = np.linspace(0, 1, bc.PROFILE_SAMPLES)
     u = np.linspace(0, 1, bc.RULING_SAMPLES)

@@ -438,12 +438,15 @@ def _first_contacts(sets: list[_FlankSet], direction: np.ndarray):
     return best, tooth, tb, ub, which, narrow
 
 
-def _rigid_inverse(poses: np.ndarray) -> np.ndarray:
+def rigid_inverse(poses: np.ndarray) -> np.ndarray:
+    """The inverse of rigid 4×4 transforms (rotation and translation), one or a stack (..., 4, 4):
+    Rᵀ, −Rᵀ·t."""
+    poses = np.asarray(poses, float)
     out = np.zeros_like(poses)
-    rt = np.transpose(poses[:, :3, :3], (0, 2, 1))
-    out[:, :3, :3] = rt
-    out[:, :3, 3] = -np.einsum("nij,nj->ni", rt, poses[:, :3, 3])
-    out[:, 3, 3] = 1.0
+    rt = np.swapaxes(poses[..., :3, :3], -1, -2)
+    out[..., :3, :3] = rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", rt, poses[..., :3, 3])
+    out[..., 3, 3] = 1.0
     return out
 
 
@@ -469,7 +472,7 @@ def first_contacts(big: BevelGearSpec, small: BevelGearSpec, big_poses: np.ndarr
     n = len(big_poses)
     out = {k: np.zeros(n) for k in ("angle", "on", "tooth", "profile", "ruling")}
     point = np.zeros((n, 3))
-    big_inv, small_inv = _rigid_inverse(big_poses), _rigid_inverse(small_poses)
+    big_inv, small_inv = rigid_inverse(big_poses), rigid_inverse(small_poses)
     for start in range(0, n, BATCH_PAIRS):
         todo = np.arange(start, min(start + BATCH_PAIRS, n))
         window = teeth_window(big, small)

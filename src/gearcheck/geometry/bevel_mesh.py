@@ -14,6 +14,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from gearcheck.geometry.bevel import BevelGearSpec
+from gearcheck.geometry.bevel_contact import rigid_inverse
 from gearcheck.geometry.bevel_play import conjugate_big_turn, rot_z4, translation4
 
 # A triangle counts as root land (dropped by tooth_half_mask) when no vertex rises this far above
@@ -34,15 +35,6 @@ def drive_poses(built: Mapping[str, np.ndarray], bigs: Sequence[str], smalls: Se
         out[name] = translation4(big_shift_mm * pose[:3, 2]) @ pose @ rot_z4(big_turn)
     for name in smalls:
         out[name] = built[name] @ rot_z4(drive_angle)
-    return out
-
-
-def rigid_inverse(pose: np.ndarray) -> np.ndarray:
-    """The inverse of a rigid 4×4 transform (rotation and translation): Rᵀ, −Rᵀ·t."""
-    out = np.eye(4)
-    rt = pose[:3, :3].T
-    out[:3, :3] = rt
-    out[:3, 3] = -rt @ pose[:3, 3]
     return out
 
 

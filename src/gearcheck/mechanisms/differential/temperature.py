@@ -31,7 +31,8 @@ import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel import BevelGearSpec
-from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period, rigid_inverse
+from gearcheck.geometry.bevel_contact import rigid_inverse
+from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period
 from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
 
