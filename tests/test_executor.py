@@ -57,3 +57,28 @@ def test_one_bisection_brackets_where_a_flag_changes():
         bisect(lambda x: True, 0.0, 1.0)
     steps = bisect(lambda x: x >= 0.3, 0.0, 1.0, tol=None, max_iter=10, check_ends=False)
     assert steps.width == pytest.approx(2.0**-10)
+
+
+def _pid_of(_state: None, _i: int) -> int:
+    import os
+
+    return os.getpid()
+
+
+def test_the_calling_process_works_as_one_of_the_jobs():
+    import os
+
+    pids = ProcessExecutor(2).map(_pid_of, [(i,) for i in range(64)])
+    assert len(pids) == 64
+    assert os.getpid() in pids and len(set(pids)) == 2  # this process and one spawned worker
+
+
+def _fails_at(_state: None, i: int) -> int:
+    if i == 30:
+        raise ArithmeticError(f"task {i}")
+    return i
+
+
+def test_a_failing_task_stops_the_map_wherever_it_ran():
+    with pytest.raises(ArithmeticError, match="task 30"):
+        ProcessExecutor(2).map(_fails_at, [(i,) for i in range(64)])

@@ -247,3 +247,88 @@ def test_a_rack_mounted_too_close_jams_and_is_reported(checked, build_bodies):
                       if r["mode"] == "towing" and r["swing"] == "out" and abs(r["pinion_angle_deg"]) <= 50.0])
     assert np.all(depth > result.summary["contact_tolerance_mm"])
     assert depth == pytest.approx(np.full(depth.shape, expected), abs=result.summary["mesh_error_bound_mm"])
+
+
+def test_probe_leaves_an_unmoved_body_where_it_is_with_the_same_results(build_bodies, monkeypatch):
+    """The probe skips re-posing a body already at the asked angle or travel: a towing and a power
+    task give the same results, bit for bit and query for query, as when every query poses both."""
+    from gearcheck.mechanisms.steering import sweep as steering_sweep
+    from gearcheck.mechanisms.steering import tasks
+    from gearcheck.sweep.plan import make_scene, run_task
+
+    run = build_bodies(TEMPLATE)
+    plan = steering_sweep.plan(run.design.params, run.assembly, run.bodies,
+                               {"towing_step_deg": 2.0, "power_step_deg": 2.0})
+    picked = [plan.tasks[0], plan.tasks[2]]  # power one way, towing both ways
+    cached = [run_task(make_scene(plan.meshes), *t) for t in picked]
+
+    def place_always(self, angle, travel, rack_mesh=tasks.RACK):
+        self.scene.set_pose(tasks.PINION, self.kin.pinion(angle))
+        self.scene.set_pose(rack_mesh, self.kin.rack(travel))
+
+    monkeypatch.setattr(tasks._Probe, "place", place_always)
+    posed = [run_task(make_scene(plan.meshes), *t) for t in picked]
+
+    for a, b in zip(cached, posed, strict=True):
+        assert _bit_same(a, b)
+
+
+def test_estimated_contacts_are_the_plain_bisections(build_bodies, monkeypatch):
+    """The sweep's shortcuts give the plain path's results, bit for bit, on the template's poses:
+    the power mode's pinion angles found from a distance query's estimate (the halving replayed
+    around it, the final bracket proven), the pushes without the repeated end queries (the plain
+    path: sweep.tools.smallest_clearing_move), and the whole rack asked at a just-bisected contact
+    as the rest of it (the plain path: the whole rack)."""
+    from gearcheck.geometry import bisect as bisect_module
+    from gearcheck.mechanisms.steering import sweep as steering_sweep
+    from gearcheck.mechanisms.steering import tasks
+    from gearcheck.sweep import tools
+    from gearcheck.sweep.plan import make_scene
+
+    run = build_bodies(TEMPLATE)
+    plan = steering_sweep.plan(run.design.params, run.assembly, run.bodies)
+    power = [t for t in plan.tasks if t[0] is tasks.power_task]
+    coarse = steering_sweep.plan(run.design.params, run.assembly, run.bodies, {"towing_step_deg": 1.0})
+    (_, (kin, directions, *towing_args)), = [t for t in coarse.tasks if t[0] is tasks.towing_tasks]
+    picked = power + [(tasks.towing_task, (kin, d, *towing_args)) for d in directions]
+    assert len(power) == 2 and len(picked) == 4
+    faces = {m.name: len(m.faces) for m in plan.meshes}
+    for flanks, rest in tasks.REST_OF.items():  # the flanks and the rest split the swept rack's triangles
+        assert faces[flanks] + faces[rest] == faces[tasks.RACK] and faces[flanks] > 0
+    proven = []
+
+    def counted(*args, **kwargs):
+        found = bisect_module.bisect_predicted(*args, **kwargs)
+        proven.append(found is not None)
+        return found
+
+    monkeypatch.setattr(tasks, "bisect_predicted", counted)
+    fast = [fn(make_scene(plan.meshes), *args) for fn, args in picked]
+    monkeypatch.undo()
+    assert sum(proven) >= 0.9 * sum(len(t[1][2]) for t in power)  # the estimate decides nearly every pose
+
+    def plain(hits_at, reach, predicted, tol, estimate_at=None):
+        return tools.smallest_clearing_move(hits_at, reach, predicted, tol)
+
+    monkeypatch.setattr(tasks, "_clearing_move", plain)
+    monkeypatch.setattr(tasks, "REST_OF", {faces: tasks.RACK for faces in tasks.REST_OF})
+    slow = [fn(make_scene(plan.meshes), *args) for fn, args in picked]
+
+    for f, s in zip(fast, slow, strict=True):
+        assert _bit_same(f, s, skip=("queries",))
+        assert f["queries"] < s["queries"]
+    assert sum(f["queries"] for f in fast[:2]) < 0.5 * sum(s["queries"] for s in slow[:2])
+
+
+def _bit_same(a, b, skip: tuple[str, ...] = ()) -> bool:
+    """Two task results equal bit for bit (floats and arrays by their bits), timings and the keys
+    in ``skip`` aside."""
+    if isinstance(a, dict):
+        return a.keys() == b.keys() and all(_bit_same(a[k], b[k], skip) for k in a
+                                            if "seconds" not in k and k not in skip)
+    if isinstance(a, (tuple, list)):
+        return len(a) == len(b) and all(_bit_same(x, y, skip) for x, y in zip(a, b, strict=True))
+    if isinstance(a, (np.ndarray, float)):
+        x, y = np.asarray(a, float), np.asarray(b, float)
+        return x.shape == y.shape and np.array_equal(x.view(np.int64), y.view(np.int64))
+    return a == b

@@ -86,6 +86,26 @@ def test_exact_model_repeats_after_one_cycle(model, exact):
             assert later[j] == pytest.approx(now[j - 1], abs=1e-9)
 
 
+def test_exact_model_shortcuts_agree_with_the_full_figures(model, exact):
+    """The sleeve's clearance alone is link_distances' first figure, and a sleeve or plate called
+    clear of the outline without measuring measures clear; over the sweep's poses, new chain and
+    one pulled 3 % into the teeth."""
+    import dataclasses
+
+    sunk = dataclasses.replace(model.wrap, pitch_mm=model.wrap.pitch_mm * 0.97)
+    called_clear = 0
+    for wrap in (model.wrap, sunk):
+        for a in track_sweep.sweep_angles(wrap, TEST_STEPS)[::3]:
+            sprocket = tc.sprocket_matrix(float(a))
+            for pose in wrap.link_matrices(float(a)):
+                sleeve, plate = exact.link_distances(sprocket, pose)
+                assert exact.sleeve_clearance(sprocket, pose) == sleeve
+                sleeve_clear, plate_clear = exact.clear_of_outline(sprocket, pose)
+                assert (not sleeve_clear or sleeve > 0.0) and (not plate_clear or plate > 0.0)
+                called_clear += sleeve_clear + plate_clear
+    assert called_clear > 0
+
+
 def test_plate_boundary_leaves_out_the_part_inside_the_sleeve(model):
     geo = model.link
     segments = plate_boundary(geo)
@@ -206,6 +226,41 @@ def test_worst_poses_are_the_reported_minima(template_run):
     scene.set_pose("plate", np.array(plate_pose.pose_b))
     assert scene.distance("sprocket", "plate").distance == pytest.approx(
         result.summary["min_tip_plate_distance_mm"], abs=1e-9)
+
+
+@pytest.mark.cad
+def test_pose_evaluation_matches_every_query_at_every_pose(build_bodies):
+    """The sweep's task (intersection tested only within 1 µm, exact figures from the plan's table)
+    gives the figures of every query at every pose, bit for bit: distances, intersections (also
+    for a chain pulled into the teeth, where the test runs), and the exact 2-D distances."""
+    import dataclasses
+
+    from gearcheck.mechanisms.track import clearance
+    from gearcheck.sweep.plan import make_scene
+
+    run = build_bodies(TEMPLATE)
+    plan = get("track").plan(run.design.params, run.assembly, run.bodies, {"steps_per_cycle": TEST_STEPS})
+    model = run.assembly.layout
+    sunk = dataclasses.replace(model, wrap=dataclasses.replace(model.wrap, pitch_mm=model.wrap.pitch_mm * 0.97))
+    scene = make_scene(plan.meshes)
+    exact = ExactSection(model.gap, model.link)
+    angles = clearance.sweep_angles(model.wrap, TEST_STEPS)
+    touching = 0
+    for m in (model, clearance.worn_model(model), sunk):
+        table = clearance.exact_table(m, angles)
+        for i in range(0, len(angles), 5):
+            a = float(angles[i])
+            got = track_sweep.evaluate_pose(scene, m, a)
+            sprocket = tc.sprocket_matrix(a)
+            scene.set_pose("sprocket", sprocket)
+            for j, pose in enumerate(m.wrap.link_matrices(a)):
+                scene.set_poses({track_sweep.SLEEVE: pose, track_sweep.PLATE: pose, "link": pose})
+                assert got[j, 0] == scene.distance("sprocket", track_sweep.SLEEVE).distance
+                assert got[j, 1] == scene.distance("sprocket", track_sweep.PLATE).distance
+                assert got[j, 2] == scene.collide("sprocket", "link")
+                assert tuple(table[i, j]) == exact.link_distances(sprocket, pose)
+                touching += got[j, 2]
+    assert touching > 0  # the sunk chain intersects the teeth: the test ran and found it
 
 
 @pytest.mark.cad

@@ -89,6 +89,56 @@ def test_seat_check_modes_and_sweep(lay, limit):
         gap.seating_radius_mm - r, abs=1e-4)
 
 
+def test_windowed_nearest_is_the_whole_polyline_search_bit_for_bit(lay):
+    """The seat check's windowed search gives the whole polyline's distance and nearest point, to
+    the last bit, for sleeve centres lifted by any wear in the bracket, turned anywhere across the
+    groove, and for points off the pin circle."""
+    poly = wear.seat_polyline(lay.sprocket.gap)
+    outline = wear._Polyline(poly)
+    assert outline.windowed
+    rng = np.random.default_rng(7)
+    half = lay.sprocket.gap.half_pitch_angle_rad
+    for _ in range(400):
+        e, phi = rng.uniform(0.0, wear.WEAR_BRACKET_MAX), rng.uniform(-1.5 * half, 1.5 * half)
+        c = lay.sprocket.gap.pitch_radius_mm * (1.0 + e) * rng.uniform(0.9, 1.05) * np.array([np.cos(phi), np.sin(phi)])
+        d_all, q_all = wear._nearest(c, poly)
+        d_win, q_win = outline.nearest(c)
+        assert d_win == d_all and np.array_equal(q_win, q_all)
+
+
+def test_sweep_check_reads_the_sweep_table_as_computed(lay):
+    """The worn-pitch sweep check at β/30 steps reads the rows of the sweep's exact table (β/60
+    steps: every other angle, the same numbers); the figures are those it computes itself."""
+    from gearcheck.mechanisms.track import clearance
+    from gearcheck.mechanisms.track.assembly import TrackModel
+
+    model = TrackModel(lay.sprocket.gap, lay.wrap, lay.link, 0.75, 0.5, 1.0, 0.015)
+    worn = clearance.worn_model(model)
+    angles = clearance.sweep_angles(model.wrap)
+    tables = [(m.wrap, angles, clearance.exact_table(m, angles)) for m in (model, worn)]
+    gap, link = lay.sprocket.gap, lay.link
+    for e in (0.0, 0.015):
+        w = wear.worn_wrap(lay.wrap.teeth, link.pitch_mm, e, lay.wrap)
+        before = int(np.ceil(wear.WORN_SWEEP_MARGIN_FRACTION * wear.WORN_SWEEP_STEPS_PER_CYCLE))
+        coarse = np.arange(-before, wear.WORN_SWEEP_STEPS_PER_CYCLE + before + 1) * w.cycle_rad \
+            / wear.WORN_SWEEP_STEPS_PER_CYCLE
+        assert wear._table_rows(tables, w, coarse) is not None
+        assert wear.sweep_check(gap, link, lay.wrap, e, tables=tables) == wear.sweep_check(gap, link, lay.wrap, e)
+    # another wrap or other angles are not read from a table
+    assert wear._table_rows(tables, wear.worn_wrap(lay.wrap.teeth, link.pitch_mm, 0.02, lay.wrap), angles) is None
+    assert wear._table_rows(tables, model.wrap, angles + 1e-9) is None
+    assert wear.wear_limit(gap, link, lay.wrap, 0.015, tables=tables) == wear.wear_limit(gap, link, lay.wrap, 0.015)
+
+
+def test_sweep_clear_decides_as_the_full_sweep_check(lay, limit):
+    """The bisection's clear/not-clear (measuring only what can decide it) is the full check's,
+    for chains pulled into the teeth (not clear), new, worn to the declared wear and the limit,
+    and worn far past it."""
+    gap, link = lay.sprocket.gap, lay.link
+    for e in (-0.03, -0.005, -0.001, 0.0, 0.015, limit.limit, limit.fail_at, 0.05, wear.WEAR_BRACKET_MAX):
+        assert wear.sweep_clear(gap, link, lay.wrap, e) == wear.sweep_check(gap, link, lay.wrap, e).ok, e
+
+
 def test_wear_field_range_and_default(template):
     assert load_template(template).params.chain.wear_elongation_pct == 1.5
     with pytest.raises(ParamError):

@@ -406,9 +406,13 @@ def cmd_build(args) -> int:
     folders = _prepared_folders(args, designs)
     executor = make_executor(args.jobs)
     if executor.jobs > 1 and len(designs) > 1:
-        tasks = [(d, f, args.tol, args.overrides) for d, f in zip(designs, folders, strict=True)]
+        # the finest default mesh (the longest build, as a rule) last in line: the executor's own
+        # process takes the last task at once while the spawned workers start and take the others
+        order = sorted(range(len(designs)), key=lambda i: -float(designs[i].impl.mesh_tol_mm))
+        tasks = [(designs[i], folders[i], args.tol, args.overrides) for i in order]
         with _display() as bars, bars("building", len(tasks), "template") as bar:
-            built = executor.map(_build_task, tasks, progress=bar.update)
+            done = executor.map(_build_task, tasks, progress=bar.update)
+        built = [b for _, b in sorted(zip(order, done, strict=True), key=lambda x: x[0])]
     else:
         built = []
         for d, f in zip(designs, folders, strict=True):

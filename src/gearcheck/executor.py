@@ -7,7 +7,8 @@ because FCL objects do not pickle). Results come back in task order, whatever th
 workers, so any reduction over them is the same for ``--jobs 1`` and ``--jobs 8``.
 
 Local processes are started with "spawn": a worker imports only what its tasks need (numpy and
-python-fcl for a sweep), never CadQuery (~2 s and ~420 MB each).
+python-fcl for a sweep), never CadQuery (~2 s and ~420 MB each). The calling process works as one
+of them.
 """
 
 from __future__ import annotations
@@ -128,13 +129,18 @@ class _Spawning:
             signal.raise_signal(s)
 
 
-def _run(job: tuple) -> Any:
-    fn, args = job
-    return fn(_worker_state, *args)
+def _run_chunk(fn: Callable[..., Any], chunk: list[tuple]) -> list:
+    return [fn(_worker_state, *args) for args in chunk]
 
 
 class ProcessExecutor:
-    """A pool of ``jobs`` spawned local processes (default: every core this process may use)."""
+    """``jobs`` processes (default: every core this process may use): this one and ``jobs − 1``
+    spawned workers, all taking chunks of tasks from one queue.
+
+    This process works too: it would only wait otherwise, and it makes its state (a sweep's BVHs)
+    while the workers start, so two processes do close to twice the work of one — the spawned
+    workers' start-up (interpreter, imports, their own state) is the only cost that does not
+    shrink with more processes, and this process hides its share of it."""
 
     def __init__(self, jobs: int | None = None):
         self.jobs = available_cores() if jobs is None else int(jobs)
@@ -142,21 +148,44 @@ class ProcessExecutor:
             raise ValueError(f"jobs must be at least 1, got {self.jobs}")
 
     def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None) -> list:
+        import collections
+
         tasks = list(tasks)
         workers = min(self.jobs, len(tasks))
         if workers <= 1:
             return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights)
-        log.debug("running %d tasks on %d processes", len(tasks), workers)
+        log.debug("running %d tasks on %d processes (this one and %d spawned)", len(tasks), workers, workers - 1)
         ctx = mp.get_context("spawn")
-        chunk = max(1, len(tasks) // (8 * workers))
+        size = max(1, len(tasks) // (8 * workers))
+        pending = collections.deque(range(0, len(tasks), size))  # chunk starts, in task order
+        out: list[Any] = [None] * len(tasks)
         with _Spawning() as spawning:
-            pool = ctx.Pool(workers, initializer=_init_worker, initargs=(setup, shared))
+            pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared))
         with pool:  # leaving the block (an error, an interrupt) terminates the workers
             spawning.deliver()
-            out = []
-            for i, result in enumerate(pool.imap(_run, [(fn, tuple(a)) for a in tasks], chunksize=chunk)):
-                out.append(result)
-                _advance(progress, weights, i)
+            state = setup(shared) if setup is not None else shared  # while the workers start
+            inflight: dict[int, Any] = {}
+
+            def finish(start: int, results: list) -> None:
+                for i, result in enumerate(results, start):
+                    out[i] = result
+                    _advance(progress, weights, i)
+
+            def feed() -> None:  # keep two chunks queued per spawned worker
+                while pending and len(inflight) < 2 * (workers - 1):
+                    start = pending.popleft()
+                    inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:start + size]))
+
+            while pending or inflight:
+                feed()
+                for start in [k for k, r in inflight.items() if r.ready()]:
+                    finish(start, inflight.pop(start).get())
+                feed()
+                if pending:  # this process takes the last chunk in line, the workers the first
+                    start = pending.pop()
+                    finish(start, [fn(state, *args) for args in tasks[start:start + size]])
+                elif inflight:
+                    next(iter(inflight.values())).wait(0.05)
             return out
 
 

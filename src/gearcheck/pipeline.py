@@ -284,24 +284,62 @@ def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
             raise ValueError(f"{spec.name}: pose differs from the assembly's (built with other parameters?)")
 
 
+class _MeshPairs:
+    """The meshes at the worst poses, for :func:`confirm`: one FCL scene per pair of parts at
+    given scales, built once and posed for each worst pose that needs it. What it answers is
+    what :func:`gearcheck.sweep.tools.meshes_overlap` and
+    :func:`gearcheck.sweep.tools.mesh_nearest_midpoint` answer (the same meshes, scaled the same
+    way, the same FCL queries); only the bounding-volume trees are not rebuilt for each query."""
+
+    def __init__(self, bodies: Mapping[str, Body]):
+        self.bodies = bodies
+        self.scenes: dict[tuple, Any] = {}
+
+    def _posed(self, name_a: str, name_b: str, worst: Any) -> Any:
+        import numpy as np
+
+        from gearcheck.sweep.engine import Scene
+
+        key = (name_a, float(worst.scale_a), name_b, float(worst.scale_b))
+        if key not in self.scenes:
+            self.scenes[key] = Scene([self.bodies[name_a].scaled(worst.scale_a).mesh,
+                                      self.bodies[name_b].scaled(worst.scale_b).mesh])
+        scene = self.scenes[key]
+        scene.set_pose(name_a, np.asarray(worst.pose_a, float))
+        scene.set_pose(name_b, np.asarray(worst.pose_b, float))
+        return scene
+
+    def overlap(self, worst: Any) -> bool:
+        """Whether the two meshes intersect at the worst pose (whole parts)."""
+        a, b = (n.partition(".")[0] for n in (worst.part_a, worst.part_b))
+        return bool(self._posed(a, b, worst).collide(a, b))
+
+    def nearest_midpoint(self, worst: Any) -> Any:
+        """Where the meshes come closest (world frame); None for a feature of a part."""
+        if "." in worst.part_a or "." in worst.part_b:
+            return None
+        d = self._posed(worst.part_a, worst.part_b, worst).distance(worst.part_a, worst.part_b)
+        return 0.5 * (d.point_a + d.point_b)
+
+
 def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
             progress: ProgressFactory = no_progress) -> list[Confirmation]:
     """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
     from gearcheck.cad.confirm import exact_closest, exact_overlap_closest
-    from gearcheck.sweep.tools import mesh_nearest_midpoint, meshes_overlap
 
     by_name = {p.name: p for p in parts}
+    meshes = _MeshPairs(bodies)
     log.info("stage confirm: %d worst poses on the exact B-rep", len(result.worst_poses))
     out = []
     with progress("exact B-rep distance at worst poses", len(result.worst_poses), "pose") as bar:
         for worst in result.worst_poses:
             bound = sum(bodies[n.partition(".")[0]].error_bound_mm for n in (worst.part_a, worst.part_b))
             overlap = None
-            if worst.mesh_distance_mm <= 0.0 or meshes_overlap(bodies, worst):
+            if worst.mesh_distance_mm <= 0.0 or meshes.overlap(worst):
                 # the meshes' nearest points mean nothing here: measure the whole solids
                 brep, overlap, point_a, point_b = exact_overlap_closest(by_name, worst)
             else:
-                brep, point_a, point_b = exact_closest(by_name, worst, near=mesh_nearest_midpoint(bodies, worst))
+                brep, point_a, point_b = exact_closest(by_name, worst, near=meshes.nearest_midpoint(worst))
             out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
                                     worst.mesh_distance_mm, brep, bound, overlap,
                                     tuple(float(v) for v in point_a), tuple(float(v) for v in point_b)))
@@ -361,10 +399,12 @@ class CheckRun:
 
 
 def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict, *,
-                 overrides: Sequence[str] = (), geometry: Any = None) -> tuple[list[Path], dict]:
+                 overrides: Sequence[str] = (), geometry: Any = None,
+                 plots: Sequence[str] | None = None) -> tuple[list[Path], dict]:
     """summary.json, sweep.csv and report.html (each atomically, in the run's staging folder);
     the files and summary.json's data. ``geometry``: the run's :class:`gearcheck.views.Geometry`
-    (its 3D view and pictures go into the report)."""
+    (its 3D view and pictures go into the report); ``plots``: the result's plots made in
+    advance (:func:`gearcheck.report.html.plots_html`), else made here."""
     from gearcheck.output import atomic_write_text
     from gearcheck.report.files import summary_json, sweep_csv
     from gearcheck.report.html import render
@@ -386,22 +426,55 @@ def write_report(design: Design, folder: Path, result: CheckResult, manifest: di
                   build=build_info, inputs=input_rows(design, overrides),
                   files=run_files(folder, [*REPORT_FILES, "manifest.json"]),
                   viewer=geometry.viewer if geometry is not None else "",
-                  pictures=geometry.pictures if geometry is not None else (), about=template_header(design))
+                  pictures=geometry.pictures if geometry is not None else (), about=template_header(design),
+                  plots=plots)
     atomic_write_text(folder / "report.html", page)
     return [folder / n for n in REPORT_FILES], json.loads(summary)
 
 
-def _geometry(design: Design, run: BuildRun, result: CheckResult, progress: ProgressFactory) -> Any:
-    """NAME.glb with the worst poses, the pictures and the report's 3D view of a check."""
-    from gearcheck.views import scene_of, write_geometry
+def _built_scene(design: Design, run: BuildRun, drawing: Any) -> Any:
+    """The scene as built (display meshes, motion frames), given to the picture process at once:
+    it draws the assembly while the worst poses are confirmed."""
+    from gearcheck.views import scene_of
+
+    scene = scene_of(design, run.assembly, run.parts)
+    if drawing is not None:
+        drawing.assembly(scene)
+    return scene
+
+
+def _plots(result: CheckResult, plotting: Any) -> list[str]:
+    """The report's plots: drawn by the plot process (given them after the sweep), or, where it
+    could not, here (the same HTML either way)."""
+    from gearcheck.report.html import plots_html
+    from gearcheck.report.plots import PlotsUnavailable
+
+    if plotting is not None:
+        try:
+            return plotting.result()
+        except PlotsUnavailable as exc:
+            log.warning("plots drawn in this process: %s", exc)
+    return plots_html(result)
+
+
+def _geometry(design: Design, run: BuildRun, result: CheckResult, progress: ProgressFactory,
+              built: Any, drawing: Any, plotting: Any) -> tuple[Any, list[str]]:
+    """NAME.glb with the worst poses, the pictures and the report's 3D view of a check, and the
+    report's plots (drawn meanwhile by their own processes)."""
+    from dataclasses import replace
+
+    from gearcheck.views import worst_views, write_geometry
 
     log.info("stage geometry: %s.glb, pictures, 3D view", design.name)
     with progress("drawing the geometry", 3, "step") as bar:
-        scene = scene_of(design, run.assembly, run.parts, result)
+        scene = replace(built, worst=worst_views(result))  # as views.scene_of with the result
+        if drawing is not None:
+            drawing.worst(scene)
         bar.update(1)
-        geometry = write_geometry(run.folder, scene, pictures=True, viewer=True)
+        geometry = write_geometry(run.folder, scene, pictures=True, viewer=True, drawing=drawing)
+        plots = _plots(result, plotting)
         bar.update(2)
-    return geometry
+    return geometry, plots
 
 
 def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: int | None = None,
@@ -414,15 +487,22 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
     anything fails or interrupts it, the previous run untouched."""
     from gearcheck.output import RunFolder
 
+    from gearcheck.views import picture_process, plot_process
+
     check_tol(tol_mm)
-    with RunFolder(folder) as txn:
+    # the picture and plot processes start (VTK, matplotlib) while the CAD is built
+    with RunFolder(folder) as txn, picture_process() as drawing, plot_process() as plotting:
         run = _build_into(design, txn.staging, tol_mm, progress, overrides)
         result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
                        progress=progress, mesh_plan=run.mesh_plan)
+        if plotting is not None:
+            plotting.draw(result.plots)
+        built = _built_scene(design, run, drawing)
         result.confirmations = confirm(result, run.parts, run.bodies, progress)
         result.verdicts.append(confirmation_verdict(result.confirmations, result.resolution))
-        geometry = _geometry(design, run, result, progress)
-        _, summary = write_report(design, txn.staging, result, run.manifest, overrides=overrides, geometry=geometry)
+        geometry, plots = _geometry(design, run, result, progress, built, drawing, plotting)
+        _, summary = write_report(design, txn.staging, result, run.manifest, overrides=overrides, geometry=geometry,
+                                  plots=plots)
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()
     _rooted(run, target, ["manifest.json", *run.manifest["files"]])

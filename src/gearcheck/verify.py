@@ -2,6 +2,10 @@
 there with the size and sha256 it records, and nothing else is; the STEP ends with its ISO
 10303-21 trailer; every STL re-reads as a closed (watertight) surface with the triangle count the
 manifest records. A run that fails here never replaces the previous one.
+
+Closed surfaces are counted on integers: the STL's corners become vertex numbers by a sort of
+their coordinates' bit patterns (equal numbers exactly for equal coordinates), each edge one
+integer key, and a sorted array of keys shows at once whether every edge occurs twice.
 """
 
 from __future__ import annotations
@@ -50,15 +54,43 @@ def read_stl(path: Path) -> np.ndarray:
     return np.frombuffer(data, record, count, 84)["v"]
 
 
+def occurs_twice(keys: np.ndarray) -> bool:
+    """Whether every value of ``keys`` (integer edge keys) occurs exactly twice (vacuously true
+    of none): sorted, the values pair up (k[0] = k[1], k[2] = k[3], …) and no pair's value
+    repeats in the next pair."""
+    if len(keys) % 2:
+        return False
+    k = np.sort(keys)
+    return bool(np.all(k[0::2] == k[1::2]) and np.all(k[1:-1:2] != k[2::2]))
+
+
+def vertex_index(points: np.ndarray) -> np.ndarray:
+    """For (n, 3) float points, an index per point such that two points get the same index
+    exactly when their coordinates are equal (−0.0 equals 0.0; NaN equals nothing, not even
+    itself): a sort of the coordinates' bit patterns instead of a sort of rows of floats."""
+    zero = np.zeros((), points.dtype)
+    bits = (points + zero).view(np.uint32 if points.dtype == np.float32 else np.uint64)  # -0.0 + 0.0 = +0.0
+    order = np.lexsort((bits[:, 2], bits[:, 1], bits[:, 0]))
+    ranked = bits[order]
+    new = np.empty(len(points), bool)
+    new[:1] = True
+    new[1:] = np.any(ranked[1:] != ranked[:-1], axis=1)
+    nan = np.isnan(points).any(axis=1)[order]
+    new |= nan  # NaN != NaN: every point with a NaN is a point of its own
+    index = np.empty(len(points), np.int64)
+    index[order] = np.cumsum(new) - 1
+    return index
+
+
 def stl_is_watertight(triangles: np.ndarray) -> bool:
     """Every undirected edge (vertices matched exactly) is shared by exactly two triangles."""
     if len(triangles) == 0:
         return False
-    _, index = np.unique(triangles.reshape(-1, 3), axis=0, return_inverse=True)
-    faces = index.reshape(-1, 3)
-    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
-    _, counts = np.unique(edges, axis=0, return_counts=True)
-    return bool(np.all(counts == 2))
+    faces = vertex_index(np.ascontiguousarray(triangles).reshape(-1, 3)).reshape(-1, 3)
+    n = np.int64(len(faces) * 3)
+    tails = np.concatenate([faces[:, 0], faces[:, 1], faces[:, 2]])
+    heads = np.concatenate([faces[:, 1], faces[:, 2], faces[:, 0]])
+    return occurs_twice(np.minimum(tails, heads) * n + np.maximum(tails, heads))
 
 
 def verify_run(folder: Path) -> dict:

@@ -6,8 +6,9 @@ view. One scene feeds all of them, so the GLB, the pictures and the viewer show 
 
 from __future__ import annotations
 
+import contextlib
 import logging
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -71,8 +72,10 @@ def picture_captions(scene: Scene) -> dict[str, str]:
     return out
 
 
-def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool) -> Geometry:
-    """NAME.glb (always), the pictures and the 3D view (a check's report) into ``folder``."""
+def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool, drawing: Any = None) -> Geometry:
+    """NAME.glb (always), the pictures and the 3D view (a check's report) into ``folder``.
+    ``drawing``: a :class:`gearcheck.report.pictures.Drawing` already given this scene (its
+    pictures are collected from it); else the pictures are drawn now."""
     from gearcheck.output import atomic_write_bytes
     from gearcheck.report.glb import glb_bytes
 
@@ -80,11 +83,15 @@ def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool) 
     name = f"{scene.name}.glb"
     atomic_write_bytes(folder / name, glb_bytes(scene))
     out.files.append(name)
+    if viewer:  # made while the picture process draws
+        from gearcheck.report.viewer import viewer_html
+
+        out.viewer = viewer_html(scene)
     if pictures:
         from gearcheck.report.pictures import PicturesUnavailable, render_pictures
 
         try:
-            drawn = render_pictures(scene)
+            drawn = drawing.result() if drawing is not None else render_pictures(scene)
         except PicturesUnavailable as exc:
             log.warning("no pictures: %s", exc)
             out.notes.append(f"The static pictures could not be drawn on this machine ({exc}); the 3D view and "
@@ -95,11 +102,37 @@ def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool) 
                 atomic_write_bytes(folder / file, data)
                 out.files.append(file)
                 out.pictures.append((captions.get(file, file), file, data))
-    if viewer:
-        from gearcheck.report.viewer import viewer_html
-
-        out.viewer = viewer_html(scene)
     return out
+
+
+def _started(factory: Any, what: str) -> Iterator[Any]:
+    try:
+        process = factory()
+    except OSError as exc:
+        log.warning("%s process not started early: %s", what, exc)
+        yield None
+        return
+    with process:
+        yield process
+
+
+@contextlib.contextmanager
+def picture_process() -> Iterator[Any]:
+    """A :class:`gearcheck.report.pictures.Drawing` started now (None where no process can be
+    started: the pictures are then drawn, or their absence explained, as without it), ended on
+    leaving the block."""
+    from gearcheck.report.pictures import Drawing
+
+    yield from _started(Drawing, "picture")
+
+
+@contextlib.contextmanager
+def plot_process() -> Iterator[Any]:
+    """A :class:`gearcheck.report.plots.Plotting` started now (None where no process can be
+    started: the plots are then drawn in this process), ended on leaving the block."""
+    from gearcheck.report.plots import Plotting
+
+    yield from _started(Plotting, "plot")
 
 
 def run_files(folder: Path, also: Sequence[str] = ()) -> list[str]:

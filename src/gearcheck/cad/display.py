@@ -24,7 +24,7 @@ from OCP.TopExp import TopExp_Explorer
 from OCP.TopLoc import TopLoc_Location
 from OCP.TopoDS import TopoDS
 
-from gearcheck.cad.mesh import triangulate
+from gearcheck.cad.mesh import node_coordinates, triangulate
 from gearcheck.cad.placement import Part
 from gearcheck.cad.step import appearance
 from gearcheck.scene import DisplayPart
@@ -72,8 +72,7 @@ def tessellate(shape, tol_mm: float, angular_rad: float = DISPLAY_ANGULAR_RAD) -
         tri = BRep_Tool.Triangulation_s(face, loc)
         if tri is None or tri.NbTriangles() == 0:  # a degenerate face: nothing to draw
             continue
-        trsf = loc.Transformation()
-        nodes = np.array([tri.Node(i).Transformed(trsf).Coord() for i in range(1, tri.NbNodes() + 1)])
+        nodes = node_coordinates(tri, loc)
         idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)]) - 1
         if face.Orientation() == TopAbs_REVERSED:
             idx = idx[:, ::-1]

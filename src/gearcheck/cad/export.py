@@ -108,6 +108,11 @@ def export_parts(
     params_file = folder / "params.toml"
     atomic_write_text(params_file, to_toml(params_data, comment=params_comment))
 
+    checked: dict[int, tuple[float, bool, bool]] = {}  # copies share a mesh: measure it once
+    for e in exported:
+        if id(e.mesh) not in checked:
+            checked[id(e.mesh)] = (e.mesh.volume(), e.mesh.is_watertight(), e.mesh.is_winding_consistent())
+
     manifest = {
         "gearcheck_version": __version__,
         "mechanism": mechanism,
@@ -121,14 +126,14 @@ def export_parts(
                 "name": e.part.name,
                 "material": e.part.material,
                 "brep_volume_mm3": e.brep_volume_mm3,
-                "mesh_volume_mm3": e.mesh.volume(),
+                "mesh_volume_mm3": checked[id(e.mesh)][0],
                 "triangles": int(len(e.mesh.faces)),
                 "vertices": int(len(e.mesh.vertices)),
                 "tolerance_mm": e.mesh.tolerance_mm,
                 "measured_mesh_error_mm": e.mesh.sampled_error_mm,
                 "mesh_error_bound_mm": e.mesh.error_bound_mm,
-                "watertight": e.mesh.is_watertight(),
-                "winding_consistent": e.mesh.is_winding_consistent(),
+                "watertight": checked[id(e.mesh)][1],
+                "winding_consistent": checked[id(e.mesh)][2],
                 "pose": np.asarray(e.part.pose).tolist(),
                 "motion": e.part.motion.to_dict() if e.part.motion is not None else {},
                 "stl": {"file": e.stl.name, "sha256": sha256(e.stl)},

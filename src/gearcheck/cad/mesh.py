@@ -31,6 +31,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
+from gearcheck.verify import occurs_twice
+
 # Default absolute chordal deflection (mm): 1/10 of the smallest backlash we resolve.
 CHORDAL_TOL_MM = 0.01
 # Angular deflection (rad): loose, so the absolute chordal tolerance governs on the gears.
@@ -64,20 +66,23 @@ class TriMesh:
         a, b, c = (self.vertices[self.faces[:, i]] for i in range(3))
         return float(np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() / 2.0)
 
-    def _directed_edges(self) -> np.ndarray:
-        f = self.faces
-        return np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
+    def _directed_edges(self) -> tuple[np.ndarray, np.ndarray, np.int64]:
+        """(tails, heads, n) of every triangle's three directed edges, n the number of vertices:
+        the edge (i, j) is the one integer i·n + j, so counting edges sorts plain integers."""
+        f = self.faces.astype(np.int64)
+        n = np.int64(max(len(self.vertices), int(f.max(initial=-1)) + 1))
+        return np.concatenate([f[:, 0], f[:, 1], f[:, 2]]), np.concatenate([f[:, 1], f[:, 2], f[:, 0]]), n
 
     def is_watertight(self) -> bool:
         """Every undirected edge is used by exactly two triangles."""
-        e = np.sort(self._directed_edges(), axis=1)
-        _, counts = np.unique(e, axis=0, return_counts=True)
-        return bool(np.all(counts == 2))
+        tails, heads, n = self._directed_edges()
+        return occurs_twice(np.minimum(tails, heads) * n + np.maximum(tails, heads))
 
     def is_winding_consistent(self) -> bool:
         """Every directed edge occurs once (its neighbour runs it the other way)."""
-        _, counts = np.unique(self._directed_edges(), axis=0, return_counts=True)
-        return bool(np.all(counts == 1))
+        tails, heads, n = self._directed_edges()
+        keys = np.sort(tails * n + heads)
+        return bool(np.all(keys[1:] != keys[:-1]))
 
 
 def _faces_of(shape):
@@ -85,6 +90,17 @@ def _faces_of(shape):
     while explorer.More():
         yield TopoDS.Face_s(explorer.Current())
         explorer.Next()
+
+
+def node_coordinates(tri, loc) -> np.ndarray:
+    """(n, 3) nodes of a face's triangulation with the face's location applied. An identity
+    location is skipped: OCCT's gp_Pnt::Transform leaves a point untouched under an identity
+    transformation, so the coordinates are the same bits either way."""
+    nodes = range(1, tri.NbNodes() + 1)
+    if loc.IsIdentity():
+        return np.array([tri.Node(i).Coord() for i in nodes])
+    trsf = loc.Transformation()
+    return np.array([tri.Node(i).Transformed(trsf).Coord() for i in nodes])
 
 
 def triangulate(topo, tol_mm: float, angular_rad: float) -> None:
@@ -122,9 +138,7 @@ def mesh_shape(shape, tol_mm: float = CHORDAL_TOL_MM, angular_rad: float = ANGUL
             raise RuntimeError("a face has no triangulation")
         if tri.NbTriangles() == 0:  # degenerate face: nothing to draw
             continue
-        trsf = loc.Transformation()
-        nodes = np.array([tri.Node(i).Transformed(trsf).Coord()
-                          for i in range(1, tri.NbNodes() + 1)])
+        nodes = node_coordinates(tri, loc)
         uv = np.array([tri.UVNode(i).Coord() for i in range(1, tri.NbNodes() + 1)])
         idx = np.array([tri.Triangle(i).Get() for i in range(1, tri.NbTriangles() + 1)]) - 1
         if face.Orientation() == TopAbs_REVERSED:

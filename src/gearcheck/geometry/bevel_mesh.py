@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -79,18 +80,36 @@ def zone_azimuth(this_pose: np.ndarray, other_pose: np.ndarray) -> float:
     return math.atan2(axis[1], axis[0])
 
 
+@dataclass(frozen=True)
+class ToothFaces:
+    """Where each face (own frame) of a bevel gear's mesh lies: its tooth (index from azimuth 0),
+    its side of that tooth's centre (−1, 0, +1) and whether it lies above the root land."""
+
+    tooth: np.ndarray
+    side: np.ndarray
+    above_root: np.ndarray
+
+    @classmethod
+    def of(cls, vertices: np.ndarray, faces: np.ndarray, spec: BevelGearSpec) -> ToothFaces:
+        pitch = spec.angular_pitch_rad
+        centroid = vertices[faces].mean(axis=1)
+        azimuth = np.arctan2(centroid[:, 1], centroid[:, 0])
+        tooth = np.round(azimuth / pitch)
+        offset = azimuth - tooth * pitch
+        polar = np.arctan2(np.hypot(vertices[:, 0], vertices[:, 1]), vertices[:, 2])
+        above_root = (polar[faces] > spec.root_angle_rad + ROOT_LAND_MARGIN_RAD).any(axis=1)
+        return cls(np.mod(tooth, spec.teeth), np.sign(offset), above_root)
+
+    def half_mask(self, side: int, teeth: np.ndarray, spec: BevelGearSpec) -> np.ndarray:
+        return self.above_root & np.isin(self.tooth, np.mod(teeth, spec.teeth)) & (self.side == side)
+
+
 def tooth_half_mask(vertices: np.ndarray, faces: np.ndarray, spec: BevelGearSpec, side: int,
-                    teeth: np.ndarray) -> np.ndarray:
+                    teeth: np.ndarray, located: ToothFaces | None = None) -> np.ndarray:
     """Faces (own frame) on the ``side`` half of the given teeth, above the root land: the side
     of a triangle is the sign of its centroid's azimuth from the nearest tooth centre. A tooth
     half carries its flank, its tip and its heel/toe edges, so every first contact of that
-    flank side (face or edge) lies in it."""
-    pitch = spec.angular_pitch_rad
-    centroid = vertices[faces].mean(axis=1)
-    azimuth = np.arctan2(centroid[:, 1], centroid[:, 0])
-    tooth = np.round(azimuth / pitch)
-    offset = azimuth - tooth * pitch
-    polar = np.arctan2(np.hypot(vertices[:, 0], vertices[:, 1]), vertices[:, 2])
-    above_root = (polar[faces] > spec.root_angle_rad + ROOT_LAND_MARGIN_RAD).any(axis=1)
-    in_window = np.isin(np.mod(tooth, spec.teeth), np.mod(teeth, spec.teeth))
-    return above_root & in_window & (np.sign(offset) == side)
+    flank side (face or edge) lies in it. ``located``: the mesh's :class:`ToothFaces`, when
+    already found (one mesh, several masks)."""
+    located = ToothFaces.of(vertices, faces, spec) if located is None else located
+    return located.half_mask(side, teeth, spec)

@@ -52,3 +52,40 @@ def bisect(flag: Callable[[float], bool], free: float, touching: float, tol: flo
         else:
             free = mid
     return Bracket(free, touching)
+
+
+def bisect_predicted(flag: Callable[[float], bool], free: float, touching: float, tol: float, estimate: float,
+                     margin: float, max_iter: int = DEFAULT_MAX_ITER) -> tuple[Bracket, int] | None:
+    """The bracket :func:`bisect` (``check_ends=False``) would end with, found with few calls of
+    ``flag`` when the change is expected at ``estimate`` (within ``margin``).
+
+    The halving is replayed: a midpoint farther than ``margin`` from the estimate is given the side
+    the estimate puts it on, a nearer one is asked of ``flag``. The final bracket is then proven:
+    ``flag`` False at its free end and True at its touching end, both asked. Where ``flag`` changes
+    once over the bracket (a monotone contact), a proven final bracket means every midpoint that
+    was not asked lies on the side the estimate gave it, so the result is the plain bisection's,
+    bit for bit. Returns the bracket and the number of calls, or None when the final bracket does
+    not hold (the estimate was wrong): the caller then bisects as usual."""
+    sign = 1.0 if touching > free else -1.0
+    calls = 0
+    asked: dict[float, bool] = {}
+
+    def ask(x: float) -> bool:
+        nonlocal calls
+        if x not in asked:
+            calls += 1
+            asked[x] = flag(x)
+        return asked[x]
+
+    for _ in range(max_iter):
+        if abs(touching - free) <= tol:
+            break
+        mid = 0.5 * (free + touching)
+        hit = ask(mid) if abs(mid - estimate) <= margin else sign * (mid - estimate) > 0.0
+        if hit:
+            touching = mid
+        else:
+            free = mid
+    if ask(free) or not ask(touching):
+        return None
+    return Bracket(free, touching), calls

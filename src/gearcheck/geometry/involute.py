@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import brentq
 
 
 def inv(alpha):
@@ -17,4 +16,6 @@ def inv_inverse(value: float) -> float:
         raise ValueError("inv(α) is non-negative")
     if value == 0:
         return 0.0
+    from scipy.optimize import brentq  # lazy: sweep workers import this module and never call it
+
     return float(brentq(lambda a: inv(a) - value, 0.0, np.radians(89.0), xtol=1e-15))

@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
 
@@ -60,6 +59,8 @@ def power_model_travel(g: RackPinionGeometry, angle: float) -> float:
     release = power_corner(g)[2]
     if angle >= power_model_angle(g, release):
         return math.nan
+    from scipy.optimize import brentq  # lazy: sweep workers import this module and never call it
+
     return float(brentq(lambda t: power_model_angle(g, t) - angle, end * g.pitch_radius, release, xtol=1e-10))
 
 

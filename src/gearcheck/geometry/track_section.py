@@ -78,6 +78,7 @@ class ExactSection:
         self.next = np.roll(np.arange(n), -1)
         self.prev = np.roll(np.arange(n), 1)
         self.max_edge = float(np.hypot(*(self.points[self.next] - self.points).T).max())
+        self.outer_radius_mm = float(np.hypot(self.points[:, 0], self.points[:, 1]).max())
         # points sorted by polar angle: a disc around a point away from the axis lies inside an
         # angular window, i.e. a slice of this order
         polar = np.arctan2(self.points[:, 1], self.points[:, 0])
@@ -119,16 +120,36 @@ class ExactSection:
         ends = np.concatenate([cand, self.next[cand]])
         return float(_segment_distances(point, to_frame(starts), to_frame(ends)).min())
 
+    def _sleeve(self, origin: np.ndarray) -> float:
+        r = self.link.sleeve_radius_mm
+        idx = self._near(origin, r + self.reach_mm)
+        if not idx.size:
+            return math.inf
+        return self._polyline_distance(origin, idx, self.points[idx], lambda i: self.points[i]) - r
+
+    def sleeve_clearance(self, sprocket_pose: np.ndarray, link_pose: np.ndarray) -> float:
+        """The first of :meth:`link_distances` alone (the same figure)."""
+        return self._sleeve(np.linalg.solve(sprocket_pose, link_pose)[:2, 3])
+
+    def clear_of_outline(self, sprocket_pose: np.ndarray, link_pose: np.ndarray) -> tuple[bool, bool]:
+        """Whether the sleeve, and the plate, certainly lie clear of the outline (distance > 0)
+        without measuring: wholly outside the circle through the outline's farthest vertex (its
+        chords lie inside it)."""
+        rel = np.linalg.solve(sprocket_pose, link_pose)
+        rot, origin = rel[:2, :2], rel[:2, 3]
+        beyond = self.outer_radius_mm + 1e-9
+        sleeve = float(np.hypot(*origin)) - self.link.sleeve_radius_mm > beyond
+        axis = -(origin @ rot)  # the sprocket axis in the link frame
+        x0, x1, y0, y1 = self.rect
+        plate = math.hypot(max(x0 - axis[0], 0.0, axis[0] - x1), max(y0 - axis[1], 0.0, axis[1] - y1)) > beyond
+        return sleeve, plate
+
     def link_distances(self, sprocket_pose: np.ndarray, link_pose: np.ndarray) -> tuple[float, float]:
         """(sleeve clearance, plate distance) in mm, negative by the depth when the outline enters
         the sleeve or the plate; inf when no outline lies within the reach."""
         rel = np.linalg.solve(sprocket_pose, link_pose)  # link frame → sprocket frame
         rot, origin = rel[:2, :2], rel[:2, 3]
-        r = self.link.sleeve_radius_mm
-        sleeve = math.inf
-        idx = self._near(origin, r + self.reach_mm)
-        if idx.size:
-            sleeve = self._polyline_distance(origin, idx, self.points[idx], lambda i: self.points[i]) - r
+        sleeve = self._sleeve(origin)
 
         def to_link(i: np.ndarray) -> np.ndarray:
             return (self.points[i] - origin) @ rot

@@ -275,10 +275,18 @@ def _confirmations(confirmations: Sequence[Confirmation]) -> str:
     return "<h2 id='exact'>Worst poses confirmed on the exact B-rep</h2>" + intro + _table(headers, rows)
 
 
-def _plots(result: CheckResult) -> str:
+def plots_html(result: CheckResult) -> list[str]:
+    """Each plot of the result as the page shows it (:func:`render` takes them made in advance)."""
+    return [plot_html(p) for p in result.plots]
+
+
+def _plots(result: CheckResult, made: Sequence[str] | None = None) -> str:
     if not result.plots:
         return ""
-    return "<h2 id='plots'>Plots</h2>" + "".join(f"<div class='plot'>{plot_html(p)}</div>" for p in result.plots)
+    made = plots_html(result) if made is None else made
+    if len(made) != len(result.plots):
+        raise ValueError(f"{len(made)} plots made for the {len(result.plots)} of the result")
+    return "<h2 id='plots'>Plots</h2>" + "".join(f"<div class='plot'>{p}</div>" for p in made)
 
 
 def _notes(notes: Sequence[str]) -> str:
@@ -368,7 +376,7 @@ def _toc(result: CheckResult, geometry: bool, inputs: bool, files: bool) -> str:
 
 def render(result: CheckResult, *, title: str, template: str, build: dict, inputs: Sequence[InputRow] = (),
            files: Sequence[str] = (), viewer: str = "", pictures: Sequence[Sequence] = (),
-           about: str = "") -> str:
+           about: str = "", plots: Sequence[str] | None = None) -> str:
     """The whole page.
 
     ``build``: manifest figures (chordal_tolerance_mm, triangles, parts); ``inputs``: the inputs
@@ -376,7 +384,8 @@ def render(result: CheckResult, *, title: str, template: str, build: dict, input
     ``files``: the run folder's files, relative names, linked; ``viewer``: the interactive 3-D
     view (HTML, self-contained) shown under "Geometry"; ``pictures``: (caption, PNG file name)
     beside the report, shown under it and in print instead of the viewer; ``about``: the
-    template's own description (:func:`gearcheck.report.inputs.template_header`)."""
+    template's own description (:func:`gearcheck.report.inputs.template_header`); ``plots``: the
+    result's plots made in advance (:func:`plots_html`), else made here."""
     parts = ["<!doctype html><html lang='en'><head><meta charset='utf-8'>",
              "<meta name='viewport' content='width=device-width, initial-scale=1'>",
              f"<title>{_e(title)}</title><style>{CSS}{PAGE_CSS}</style></head><body>",
@@ -388,5 +397,5 @@ def render(result: CheckResult, *, title: str, template: str, build: dict, input
     geometry = _geometry(viewer, pictures)
     parts.append(_toc(result, bool(geometry), bool(inputs), bool(files)))
     parts += [geometry, _verdicts(result), _comparisons(result.comparisons), _confirmations(result.confirmations),
-              _plots(result), _notes(result.notes), _inputs(inputs, template), _files(files), "</body></html>"]
+              _plots(result, plots), _notes(result.notes), _inputs(inputs, template), _files(files), "</body></html>"]
     return "\n".join(p for p in parts if p)

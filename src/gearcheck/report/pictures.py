@@ -3,11 +3,13 @@ assembly as built) and ``worst_N.png`` (worst pose N, zoomed on the closest poin
 marked), drawn offscreen with VTK (installed with CadQuery) from the same :class:`Scene` and
 cameras (:mod:`gearcheck.report.camera`) as the report's 3D view.
 
-VTK draws in a child process (``python -m gearcheck.report.pictures``, the scene pickled on its
-stdin, the pictures pickled on its stdout): offscreen OpenGL goes through EGL
-(``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow``, no X display), and on a machine with no
-EGL, VTK falls back to OSMesa and, where that is missing too, crashes the process (a
-segmentation fault, seen with VTK 9.6). In a child, such a crash becomes
+VTK draws in a child process (``python -m gearcheck.report.pictures``, the scene as built and
+then its worst poses pickled on its stdin, the pictures pickled on its stdout). A check starts it
+with the run (:class:`Drawing`): it loads VTK while the CAD is built and draws the assembly while
+the worst poses are confirmed, and the pictures are the same bytes as drawn at once. Offscreen
+OpenGL goes through EGL (``VTK_DEFAULT_OPENGL_WINDOW=vtkEGLRenderWindow``, no X display), and on
+a machine with no EGL, VTK falls back to OSMesa and, where that is missing too, crashes the
+process (a segmentation fault, seen with VTK 9.6). In a child, such a crash becomes
 :class:`PicturesUnavailable` with VTK's own last words, never a dead pipeline or a silent gap.
 
 The pictures are deterministic: the same scene gives the same bytes (no time stamp in the PNG,
@@ -21,6 +23,7 @@ import os
 import pickle
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 
@@ -53,27 +56,93 @@ class PicturesUnavailable(RuntimeError):
         self.reason = reason
 
 
-def pictures(scene: Scene, timeout_s: float = TIMEOUT_S) -> dict[str, bytes]:
-    """``{"assembly.png": …, "worst_1.png": …, …}`` (PNG bytes) of the scene, drawn by VTK in a
-    child process. Raises :class:`PicturesUnavailable` when it cannot draw."""
+def _messages(scene: Scene) -> list[bytes]:
+    """What the picture process reads on its stdin: the scene as built (no worst poses: the
+    assembly picture needs nothing else), then the worst poses."""
+    return [pickle.dumps(replace(scene, worst=[])), pickle.dumps(list(scene.worst))]
+
+
+def _environment() -> dict[str, str]:
     env = dict(os.environ)
     env.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    return env
+
+
+def _received(returncode: int, stdout: bytes, stderr: bytes) -> dict[str, bytes]:
+    """The pictures a finished picture process gave, or :class:`PicturesUnavailable` saying why not."""
+    if returncode != 0:
+        how = f"signal {-returncode}" if returncode < 0 else f"exit code {returncode}"
+        raise PicturesUnavailable(f"VTK could not draw offscreen ({how}): {_last_words(stderr)}")
     try:
-        done = subprocess.run([sys.executable, "-m", "gearcheck.report.pictures"], input=pickle.dumps(scene),
-                              capture_output=True, env=env, timeout=timeout_s, check=False)
-    except subprocess.TimeoutExpired as exc:
-        raise PicturesUnavailable(f"VTK did not finish the pictures in {timeout_s:.0f} s") from exc
-    if done.returncode != 0:
-        how = f"signal {-done.returncode}" if done.returncode < 0 else f"exit code {done.returncode}"
-        raise PicturesUnavailable(f"VTK could not draw offscreen ({how}): {_last_words(done.stderr)}")
-    try:
-        out = pickle.loads(done.stdout)
+        out = pickle.loads(stdout)
     except (pickle.UnpicklingError, EOFError, ValueError) as exc:
-        raise PicturesUnavailable(f"the picture process gave no pictures: {_last_words(done.stderr)}") from exc
+        raise PicturesUnavailable(f"the picture process gave no pictures: {_last_words(stderr)}") from exc
     png = b"\x89PNG\r\n\x1a\n"
     if not isinstance(out, dict) or not all(isinstance(v, bytes) and v.startswith(png) for v in out.values()):
         raise PicturesUnavailable("the picture process gave something other than PNG pictures")
     return out
+
+
+def pictures(scene: Scene, timeout_s: float = TIMEOUT_S) -> dict[str, bytes]:
+    """``{"assembly.png": …, "worst_1.png": …, …}`` (PNG bytes) of the scene, drawn by VTK in a
+    child process. Raises :class:`PicturesUnavailable` when it cannot draw."""
+    try:
+        done = subprocess.run([sys.executable, "-m", "gearcheck.report.pictures"], input=b"".join(_messages(scene)),
+                              capture_output=True, env=_environment(), timeout=timeout_s, check=False)
+    except subprocess.TimeoutExpired as exc:
+        raise PicturesUnavailable(f"VTK did not finish the pictures in {timeout_s:.0f} s") from exc
+    return _received(done.returncode, done.stdout, done.stderr)
+
+
+class Drawing:
+    """The picture process of :func:`pictures`, started before its scene exists so that its
+    start-up (Python, VTK) and the assembly picture overlap the run's other stages: started
+    empty, given the scene as built (:meth:`assembly`: it draws the assembly picture at once),
+    then the worst poses (:meth:`worst`), and :meth:`result` collects the same pictures, with
+    the same errors, as :func:`pictures` of the whole scene. Use it in a ``with`` block: leaving
+    it ends the process if its pictures were not collected."""
+
+    def __init__(self, timeout_s: float = TIMEOUT_S):
+        from gearcheck.report.child import ChildProcess
+
+        self.timeout_s = timeout_s
+        self._child = ChildProcess("gearcheck.report.pictures", _environment())
+        self._sent = 0
+
+    def assembly(self, scene: Scene) -> None:
+        """Give the process the scene as built (its worst poses, if any, are not drawn yet)."""
+        if self._sent != 0:
+            raise RuntimeError("the scene was given already")
+        self._child.send(_messages(scene)[0])
+        self._sent = 1
+
+    def worst(self, scene: Scene) -> None:
+        """Give the process the worst poses of ``scene`` (the scene given to :meth:`assembly`,
+        with its worst poses) and let it finish."""
+        if self._sent != 1:
+            raise RuntimeError("give the scene as built first")
+        self._child.send(_messages(scene)[1])
+        self._child.finish()
+        self._sent = 2
+
+    def result(self) -> dict[str, bytes]:
+        """The pictures (waits for the process), or :class:`PicturesUnavailable`."""
+        if self._sent != 2:
+            raise RuntimeError("give the scene and its worst poses first")
+        done = self._child.wait(self.timeout_s)
+        if done is None:
+            raise PicturesUnavailable(f"VTK did not finish the pictures in {self.timeout_s:.0f} s")
+        return _received(*done)
+
+    def close(self) -> None:
+        """End the process (if still running) and release its pipes."""
+        self._child.close()
+
+    def __enter__(self) -> Drawing:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
 
 render_pictures = pictures  # the name the pipeline calls it by
@@ -357,45 +426,74 @@ def _fmt(x: float | None) -> str:
 
 def render(scene: Scene) -> dict[str, bytes]:
     """The pictures (in this process: needs VTK and an offscreen OpenGL)."""
-    stage = _Stage(scene)
-    world = scene.world_vertices()
-    everything = np.concatenate(list(world.values()))
-    stage.pose(None)
-    stage.fit(everything, DEFAULT_DIRECTION)
-    stage.text([f"{scene.name}: as built ({len(scene.parts)} parts)"])
-    out = {"assembly.png": stage.png()}
-    for i, view in enumerate(scene.worst, start=1):
-        stage.clear()
-        stage.cut(None)
-        names = pair(view)
-        stage.pose(view, names)
-        lines = [f"worst pose {i}: {view.label}"]
-        if view.point_a is not None and view.point_b is not None:
-            a, b = np.asarray(view.point_a, float), np.asarray(view.point_b, float)
-            radius = zoom_radius(scene, view)
-            direction = orbit_direction(*azimuth_elevation(worst_direction(scene, view)))
-            stage.look(0.5 * (a + b), direction, radius / math.sin(math.radians(FOV_DEG / 2)))
-            stage.cut(section(scene, view))
-            stage.marks(a, b, 0.02 * radius)
-            lines.append(f"closest points {_fmt(view.distance_mm)} (red on {names[0]}, blue on {names[1]})"
-                         if len(names) == 2 else f"closest points {_fmt(view.distance_mm)}")
-        else:
-            shown = scene.world_vertices(view)
-            stage.fit(np.concatenate([shown[n] for n in names if n in shown] or [everything]), DEFAULT_DIRECTION)
-        if view.note:
-            lines.append(view.note)
-        stage.text([line for line in lines if line])
-        out[f"worst_{i}.png"] = stage.png()
-    return out
+    drawer = _Drawer(scene)
+    return {**drawer.assembly(), **drawer.worst(scene)}
+
+
+class _Drawer:
+    """The pictures in their order: the assembly first (it needs only the parts), then each
+    worst pose, on one stage (:func:`render` draws both at once, the picture process as its
+    messages come)."""
+
+    def __init__(self, scene: Scene):
+        self.stage = _Stage(scene)
+        self.everything = np.concatenate(list(scene.world_vertices().values()))
+
+    def assembly(self) -> dict[str, bytes]:
+        stage, scene = self.stage, self.stage.scene
+        stage.pose(None)
+        stage.fit(self.everything, DEFAULT_DIRECTION)
+        stage.text([f"{scene.name}: as built ({len(scene.parts)} parts)"])
+        return {"assembly.png": stage.png()}
+
+    def worst(self, scene: Scene) -> dict[str, bytes]:
+        """The worst poses of ``scene`` (the stage's scene with its worst poses)."""
+        stage, out = self.stage, {}
+        for i, view in enumerate(scene.worst, start=1):
+            stage.clear()
+            stage.cut(None)
+            names = pair(view)
+            stage.pose(view, names)
+            lines = [f"worst pose {i}: {view.label}"]
+            if view.point_a is not None and view.point_b is not None:
+                a, b = np.asarray(view.point_a, float), np.asarray(view.point_b, float)
+                radius = zoom_radius(scene, view)
+                direction = orbit_direction(*azimuth_elevation(worst_direction(scene, view)))
+                stage.look(0.5 * (a + b), direction, radius / math.sin(math.radians(FOV_DEG / 2)))
+                stage.cut(section(scene, view))
+                stage.marks(a, b, 0.02 * radius)
+                lines.append(f"closest points {_fmt(view.distance_mm)} (red on {names[0]}, blue on {names[1]})"
+                             if len(names) == 2 else f"closest points {_fmt(view.distance_mm)}")
+            else:
+                shown = scene.world_vertices(view)
+                stage.fit(np.concatenate([shown[n] for n in names if n in shown] or [self.everything]),
+                          DEFAULT_DIRECTION)
+            if view.note:
+                lines.append(view.note)
+            stage.text([line for line in lines if line])
+            out[f"worst_{i}.png"] = stage.png()
+        return out
 
 
 def _child() -> int:
-    scene = pickle.loads(sys.stdin.buffer.read())
+    """The picture process: VTK loaded while it waits; the scene as built (the assembly is drawn
+    as soon as it comes), then the worst poses, on stdin; the pictures pickled on stdout."""
+    import vtkmodules.vtkFiltersCore  # noqa: F401  (loaded before the scene comes)
+    import vtkmodules.vtkFiltersSources  # noqa: F401
+    import vtkmodules.vtkIOImage  # noqa: F401
+    import vtkmodules.vtkRenderingFreeType  # noqa: F401
+    import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
+
+    _font_file()
     # the pictures go to the real stdout; anything VTK prints there goes to stderr instead
     out = os.fdopen(os.dup(1), "wb")
     sys.stdout.flush()
     os.dup2(2, 1)
-    drawn = render(scene)
+    stdin = sys.stdin.buffer
+    built = pickle.load(stdin)
+    drawer = _Drawer(built)
+    drawn = drawer.assembly()
+    drawn.update(drawer.worst(replace(built, worst=pickle.load(stdin))))
     out.write(pickle.dumps(drawn))
     out.close()
     return 0

@@ -224,3 +224,86 @@ def plot_html(plot: Plot, *, key: bool = True) -> str:
         return svg
     caption = f"<p class='caption'>{html.escape(plot.caption)}</p>" if plot.caption else ""
     return svg + series_key(entries) + marker_key(plot) + caption
+
+
+class PlotsUnavailable(RuntimeError):
+    """The plot process gave no plots (it died, hung, or gave something else); the caller draws
+    them itself."""
+
+
+class Plotting:
+    """The report's plots drawn by a process of their own (``python -m gearcheck.report.plots``,
+    the plots pickled on its stdin, their HTML on its stdout), started with the run so that
+    matplotlib loads while the CAD is built and the plots are drawn while the worst poses are
+    confirmed and pictured. The same :func:`plot_html` draws them there as here, with the same
+    settings (:data:`RC`: a fixed SVG hash salt, no date), so the HTML is the same text. Use it
+    in a ``with`` block: leaving it ends the process if its plots were not collected."""
+
+    def __init__(self, timeout_s: float = 300.0):
+        from gearcheck.report.child import ChildProcess
+
+        self.timeout_s = timeout_s
+        self._child = ChildProcess("gearcheck.report.plots")
+        self._count: int | None = None
+
+    def draw(self, plots: list[Plot]) -> None:
+        """Give the process the plots to draw (once)."""
+        import pickle
+
+        if self._count is not None:
+            raise RuntimeError("the plots were given already")
+        self._count = len(plots)
+        self._child.send(pickle.dumps(list(plots)))
+        self._child.finish()
+
+    def result(self) -> list[str]:
+        """Each plot's HTML (:func:`plot_html`), in order; :class:`PlotsUnavailable` otherwise."""
+        import pickle
+
+        if self._count is None:
+            raise RuntimeError("give the plots first")
+        done = self._child.wait(self.timeout_s)
+        if done is None:
+            raise PlotsUnavailable(f"the plot process did not finish in {self.timeout_s:.0f} s")
+        returncode, stdout, stderr = done
+        if returncode != 0:
+            last = stderr.decode("utf-8", "replace").strip().splitlines()[-1:] or ["no message"]
+            raise PlotsUnavailable(f"the plot process ended with status {returncode}: {last[0]}")
+        try:
+            out = pickle.loads(stdout)
+        except (pickle.UnpicklingError, EOFError, ValueError) as exc:
+            raise PlotsUnavailable("the plot process gave no plots") from exc
+        if not isinstance(out, list) or len(out) != self._count or not all(isinstance(p, str) for p in out):
+            raise PlotsUnavailable("the plot process gave something other than the plots asked for")
+        return out
+
+    def close(self) -> None:
+        self._child.close()
+
+    def __enter__(self) -> Plotting:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def _child() -> int:
+    """The plot process: matplotlib loaded while it waits; the plots on stdin, their HTML out."""
+    import os
+    import pickle
+    import sys
+
+    _plt()
+    out = os.fdopen(os.dup(1), "wb")  # the HTML goes to the real stdout; prints go to stderr
+    sys.stdout.flush()
+    os.dup2(2, 1)
+    plots = pickle.load(sys.stdin.buffer)
+    out.write(pickle.dumps([plot_html(p) for p in plots]))
+    out.close()
+    return 0
+
+
+if __name__ == "__main__":
+    import sys
+
+    sys.exit(_child())

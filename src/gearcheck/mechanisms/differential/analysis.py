@@ -72,7 +72,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from gearcheck.geometry.involute import inv
 
@@ -202,7 +201,7 @@ def max_small_shift_for_tip(geom: ConeGeometry, pressure_angle_rad: float) -> fl
         return lo
     if margin(hi) >= 0.0:
         return hi
-    return float(brentq(margin, lo, hi, xtol=1e-6))
+    return float(_brentq()(margin, lo, hi, xtol=1e-6))
 
 
 def min_small_shift_for_interference(geom: ConeGeometry, pressure_angle_rad: float) -> float:
@@ -218,7 +217,7 @@ def min_small_shift_for_interference(geom: ConeGeometry, pressure_angle_rad: flo
         return lo
     if margin(hi) < 0.0:
         return hi
-    return float(brentq(margin, lo, hi, xtol=1e-6))
+    return float(_brentq()(margin, lo, hi, xtol=1e-6))
 
 
 @dataclass(frozen=True)
@@ -449,3 +448,11 @@ def model_per_side(params, shim_mm: float) -> PerSide:
     return PerSide(warm=warm, cold=warm - r.cold.per_side_arcmin, clean_warm=clean_warm,
                    clean_cold=clean_warm - r.cold.clean_per_side_arcmin, drop=r.cold.per_side_arcmin,
                    clean_drop=r.cold.clean_per_side_arcmin)
+
+
+def _brentq():
+    """scipy's root finder, imported when first needed (sweep workers import this module and never
+    call it)."""
+    from scipy.optimize import brentq
+
+    return brentq

@@ -256,7 +256,10 @@ def _summary(setup: SweepSetup, data: SweepData, by_key: dict) -> dict:
         "max_mesh_exact_contact_deviation_arcmin": float(data.contact_dev.max()),
         "max_mesh_exact_play_deviation_arcmin": float(np.nanmax(data.total_dev)),
         "angles_per_cycle": len(data.angles),
-        "poses": int(sum(r["calls"] for r in by_key.values())),
+        "contact_brackets": len(by_key),
+        "fcl_queries": int(sum(r["calls"] for r in by_key.values())),
+        "contact_brackets_by_estimate": {how: sum(r["found_by"] == how for r in by_key.values())
+                                         for how in ("hint", "distance", "bisection")},
         "exact_solves": data.exact_solves,
         "exact_solves_reused_by_congruence": data.exact_reused * len(DIRECTIONS),
         "cycle_deg": math.degrees(data.period_rad),
@@ -336,17 +339,18 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
 
 
 def _timings(setup: SweepSetup, by_key: dict, wall_s: float, range_s: float, onset_s: float) -> dict:
-    """Speed of the sweep: collide calls per second (over the time spent bisecting, per worker,
-    and over the wall time of the whole sweep), one play measurement (one big gear against one
-    small gear, both ways, on the meshes), one exact contact solve (the vectorised batch), the
-    exact range (worker time) and its onset solves, wall time of the sweep."""
-    calls = sum(r["calls"] for r in by_key.values())
+    """Speed of the sweep: FCL queries per second (over the time spent on the meshes, per worker),
+    mesh contacts (one pair, one way, bracketed) per second of the sweep's wall time, one play
+    measurement (one big gear against one small gear, both ways, on the meshes), one exact
+    contact solve (the vectorised batch), the exact range (worker time) and its onset solves, wall time of the sweep."""
+    calls = sum(r["calls"] for r in by_key.values())  # FCL queries: collisions and distances
     mesh_s = sum(r["mesh_s"] for r in by_key.values())
     pair_play_s = [by_key[key]["mesh_s"] + by_key[key[:5] + (-1,)]["mesh_s"] for key in by_key if key[5] == 1]
     return {
-        "collide_calls": int(calls),
-        "collide_calls_per_s_per_worker": calls / mesh_s,
-        "poses_per_s": calls / wall_s,
+        "fcl_queries": int(calls),
+        "fcl_queries_per_s_per_worker": calls / mesh_s,
+        "contacts": len(by_key),
+        "contacts_per_s": len(by_key) / wall_s,
         "ms_per_play_measurement": 1e3 * float(np.mean(pair_play_s)),
         "ms_per_play_measurement_max": 1e3 * float(np.max(pair_play_s)),
         "ms_per_exact_contact": 1e3 * setup.exact_s / max(setup.exact_solves, 1),

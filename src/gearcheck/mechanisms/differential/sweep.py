@@ -72,7 +72,7 @@ from typing import Any
 import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
-from gearcheck.geometry.bevel_mesh import drive_poses, play_period, tooth_half_mask, zone_azimuth
+from gearcheck.geometry.bevel_mesh import ToothFaces, drive_poses, play_period, zone_azimuth
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.differential.assembly import Layout
 from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, congruent_groups,
@@ -80,6 +80,7 @@ from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, con
                                                            temperature_grid)
 from gearcheck.mechanisms.differential.thermal import GearThermal, thermal_state
 from gearcheck.sweep.bodies import Body, MeshData, submesh
+from gearcheck.geometry.bisect import bisect_predicted
 from gearcheck.sweep.engine import Scene, bisect_contact
 from gearcheck.sweep.tools import CountedScene
 
@@ -91,32 +92,65 @@ BISECTION_TOL_ARCMIN = 1e-4
 # mesh-error bound, then by three times it.
 BRACKET_INSIDE_ARCMIN = 0.05
 BRACKET_OUTSIDE_ARCMIN = 0.3
+# Midpoints within this many bisection tolerances of a distance query's contact estimate are
+# asked of the meshes; farther ones are given the side the estimate puts them on, then the final
+# bracket is proven from both sides. The estimate is good to about one tolerance where the nearest
+# mesh features stay the same up to contact, to about a hundred where they change: a narrow
+# margin first, then a wide one, then the plain bisection.
+NEWTON_MARGINS_TOL = (0.5, 160.0)
 # Pruning: extra teeth kept beyond the exact model's window and the cycle's turn.
 PRUNE_EXTRA_TEETH = 1
 # The states measured at every shim (the others at the template's shim only).
 EVERY_SHIM_STATES = ("warm", "cold")
 DIRECTIONS = (1, -1)
 OPTIONS = ("angles_per_cycle", "shims_mm", "range_shims")
-# Exact range tasks: temperatures per task; their progress weight per temperature, in collide
-# calls (one temperature's exact solves take about as long as this many collide calls).
+# Exact range tasks: temperatures per task; their progress weight per temperature, in contacts
+# (one temperature's exact solves take about as long as this many mesh contacts, one pair one way).
 RANGE_CHUNK = 6
-RANGE_WEIGHT_PER_TEMPERATURE = 25
+RANGE_WEIGHT_PER_TEMPERATURE = 2
 
 
 # --------------------------------------------------------------------------------------------
 # Meshes
 
-def mesh_name(big: str, small: str, direction: int, part: str, state: str) -> str:
-    return f"{big}|{small}|{'+' if direction > 0 else '-'}|{part}|{state}"
+def mesh_name(big: str, small: str, direction: int, part: str, variant: str) -> str:
+    return f"{big}|{small}|{'+' if direction > 0 else '-'}|{part}|{variant}"
+
+
+def mesh_variant(thermal: Mapping[str, GearThermal], big: str, small: str, state: str) -> str:
+    """Which pruned big-gear mesh a state's pair uses: "" (as built) when both gears scale alike,
+    else the state's own (scaled by the ratio of the two gears' factors)."""
+    return "" if thermal[big].scale == thermal[small].scale else state
+
+
+def normalised_poses(thermal: Mapping[str, GearThermal], big: str, small: str, big_pose: np.ndarray,
+                     small_pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """The pair in a thermal state as meshes *as built* (the big one scaled by the ratio r of the
+    two factors about its frame origin, r = 1 when both are steel): the two poses, and the ratio.
+
+    A gear in a state is its mesh scaled by f about its frame origin, then posed
+    (:meth:`.GearThermal.cold_pose_about_origin`): x = R·(f·p) + t = f·(R·p + t/f). Scaling the
+    whole world by 1/f_small therefore leaves the small gear as built, posed (R, t/f_small), and
+    the big one scaled by r = f_big/f_small, posed (R, t/f_small). A uniform scale of the world
+    changes no angle and no contact: the turn to contact is the same, so every state shares the
+    meshes as built instead of one scaled copy (and one BVH) per state."""
+    tb, ts = thermal[big], thermal[small]
+    pb, ps = tb.cold_pose_about_origin(big_pose), ts.cold_pose_about_origin(small_pose)
+    pb[:3, 3] /= ts.scale
+    ps[:3, 3] /= ts.scale
+    return pb, ps, tb.scale / ts.scale
 
 
 def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: Mapping[str, dict[str, GearThermal]]
                   ) -> list[MeshData]:
-    """Per big/small pair, direction and state: the two gears' tooth halves that can touch, each
-    gear scaled as in that state."""
+    """Per big/small pair and direction: the two gears' tooth halves that can touch, as built
+    (shared by every state whose gears scale alike, see :func:`normalised_poses`), and for a
+    state where they do not, the big gear's scaled by the ratio of the factors."""
     specs = layout.specs
     big_spec, small_spec = specs.big, specs.small
-    masks = {}  # the same triangles in every state (a state only scales the vertices)
+    out = []
+    located = {n: ToothFaces.of(bodies[n].mesh.vertices, bodies[n].mesh.faces, big_spec if n in layout.big_gears
+                                else small_spec) for n in layout.big_gears + layout.small_gears}
     for big in layout.big_gears:
         for small in layout.small_gears:
             b, s = bodies[big], bodies[small]
@@ -128,25 +162,55 @@ def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: 
             big_teeth = np.arange(cb - wb, cb + wb + 2)
             small_teeth = np.arange(cs - ws - 1, cs + ws + 1)
             for d in DIRECTIONS:
-                masks[(big, small, d)] = (tooth_half_mask(b.mesh.vertices, b.mesh.faces, big_spec, d, big_teeth),
-                                          tooth_half_mask(s.mesh.vertices, s.mesh.faces, small_spec, d, small_teeth))
-    out = []
-    for state, thermal in thermal_by_state.items():
-        scaled = {n: bodies[n].scaled(thermal[n].scale, thermal[n].datum_local).mesh
-                  for n in layout.big_gears + layout.small_gears}
-        for (big, small, d), (mb, ms) in masks.items():
-            out.append(submesh(scaled[big], mesh_name(big, small, d, "big", state), mb))
-            out.append(submesh(scaled[small], mesh_name(big, small, d, "small", state), ms))
+                mb = located[big].half_mask(d, big_teeth, big_spec)
+                ms = located[small].half_mask(d, small_teeth, small_spec)
+                variants = dict.fromkeys(mesh_variant(th, big, small, state) for state, th in thermal_by_state.items())
+                for variant in variants:
+                    mesh = b.mesh
+                    if variant:
+                        th = thermal_by_state[variant]
+                        mesh = b.scaled(th[big].scale / th[small].scale).mesh
+                    out.append(submesh(mesh, mesh_name(big, small, d, "big", variant), mb))
+                out.append(submesh(s.mesh, mesh_name(big, small, d, "small", ""), ms))
     return out
 
 
 # --------------------------------------------------------------------------------------------
 # One measurement (a worker task: numpy + fcl only)
 
+def _newton_turn(scene: CountedScene, big_mesh: str, small_mesh: str, big_pose: np.ndarray, turn: float,
+                 direction: int) -> float | None:
+    """Where the big gear's turn closes the mesh gap, from one distance query at ``turn``: the
+    gap d between the nearest points closes at the rate n·(a × (p − o)) per radian (n the unit
+    normal from the big gear's nearest point p to the small gear's, a and o the big gear's axis
+    and origin), so contact is expected d / rate further on. An estimate only (None when the pose
+    already touches or the gap does not close): the contact is still proven by collisions."""
+    pose = big_pose @ bp.rot_z4(turn)
+    scene.set_pose(big_mesh, pose)
+    near = scene.distance(big_mesh, small_mesh)
+    gap = near.point_b - near.point_a
+    d = float(np.linalg.norm(gap))
+    if not d > 0.0:
+        return None
+    rate = float(np.dot(gap / d, np.cross(pose[:3, 2], near.point_a - pose[:3, 3])))
+    if not rate * direction > 0.0:
+        return None
+    return turn + d / rate
+
+
 def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndarray, small_pose: np.ndarray,
-                 exact_rad: float, direction: int, bound_rad: float, tol_rad: float) -> dict:
+                 exact_rad: float, direction: int, bound_rad: float, tol_rad: float,
+                 hint: float | None = None) -> dict:
     """Mesh contact turn of the big gear one way, bracketed around the exact one (contact proven
-    from both sides), and whether the centred pose (turn 0) collides."""
+    from both sides), and whether the centred pose (turn 0) collides.
+
+    The bracket is the bisection's, started at the exact contact (widened by the mesh-error bound
+    if it does not hold), found in few collisions where the contact can be expected: at ``hint``
+    (a congruent pair's measured contact) or else where one distance query puts it
+    (:func:`_newton_turn`); :func:`gearcheck.geometry.bisect.bisect_predicted` replays the
+    halving, asks only the midpoints near the estimate, and proves the final bracket from both
+    sides. If the estimate lies outside the first bracket, or the final bracket does not hold, the
+    plain bisection runs (widening the bracket as needed)."""
     t0 = time.perf_counter()
     counted = CountedScene(scene)
     counted.set_pose(small_mesh, small_pose)
@@ -158,27 +222,57 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
     centred_collides = collides(0.0)
     inside = BRACKET_INSIDE_ARCMIN / bp.ARCMIN_PER_RAD
     outside = BRACKET_OUTSIDE_ARCMIN / bp.ARCMIN_PER_RAD
-    bracket, widened = None, 0
-    for widen in (0.0, bound_rad, 3.0 * bound_rad):
-        try:
-            bracket = bisect_contact(collides, exact_rad - direction * (inside + widen),
-                                     exact_rad + direction * (outside + widen), tol_rad)
+    levels = [(exact_rad - direction * (inside + w), exact_rad + direction * (outside + w))
+              for w in (0.0, bound_rad, 3.0 * bound_rad)]
+    bracket, widened, how = None, 0, "bisection"
+    newton: list[float | None] = []  # the distance query's estimate, once asked
+
+    def estimate_of(guess: float | None) -> float | None:
+        if guess is not None:
+            return guess
+        if not newton:
+            newton.append(_newton_turn(counted, big_mesh, small_mesh, big_pose, levels[0][0], direction))
+        return newton[0]
+
+    guesses: list[tuple[float | None, float, str]] = [(hint, 0.0, "hint")] if hint is not None else []
+    guesses += [(None, m * tol_rad, "distance") for m in NEWTON_MARGINS_TOL]
+    for guess, margin, label in guesses:
+        estimate = estimate_of(guess)
+        if estimate is None:
+            continue
+        lo, hi = levels[0]
+        if not ((estimate - lo) * direction > margin and (hi - estimate) * direction > margin):
+            continue  # expected outside the first bracket: the plain path decides how far to widen
+        found = bisect_predicted(collides, lo, hi, tol_rad, estimate, margin)
+        if found is not None:
+            bracket, how = found[0], label
             break
-        except ValueError:
-            widened += 1
+    if bracket is None:
+        for widen, (lo, hi) in enumerate(levels):
+            try:
+                bracket = bisect_contact(collides, lo, hi, tol_rad)
+                widened = widen
+                break
+            except ValueError:
+                continue
     if bracket is None:
         raise RuntimeError(f"{big_mesh} vs {small_mesh}: no contact bracket within 3× the mesh-error bound of the "
                            f"exact contact ({bp.arcmin(exact_rad):.4f}′): mesh and exact model disagree")
     return {"free_rad": bracket.free, "touching_rad": bracket.touching, "centred_collides": centred_collides,
-            "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened}
+            "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened, "found_by": how,
+}
 
 
 def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float) -> dict:
     """The mesh contact of each listed pair posed congruently to one exact contact (solved in the
     planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
-    the pair itself and its congruent twins."""
-    mesh = [_bisect_mesh(scene, bm, sm, bpose, spose, exact_rad, direction, bound, tol_rad)
-            for bm, sm, bpose, spose, bound in meshes]
+    the pair itself and its congruent twins (each twin expects the contact where the pair before
+    it had it, and proves its own)."""
+    mesh = []
+    hint = None
+    for bm, sm, bpose, spose, bound in meshes:
+        mesh.append(_bisect_mesh(scene, bm, sm, bpose, spose, exact_rad, direction, bound, tol_rad, hint))
+        hint = 0.5 * (mesh[-1]["free_rad"] + mesh[-1]["touching_rad"])
     return {"exact_rad": exact_rad, "mesh": mesh}
 
 
@@ -274,16 +368,13 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
     tasks: list[tuple] = []
     owners: list[list[tuple]] = []
     weights: list[int] = []
-    # collide calls per pair, for progress: the centred pose, the two bracket ends, the bisection
-    per_pair = 3 + math.ceil(math.log2((BRACKET_INSIDE_ARCMIN + BRACKET_OUTSIDE_ARCMIN) / BISECTION_TOL_ARCMIN))
     for n, (keys, pairs) in enumerate(pending):
-        state = keys[0][1]
         for d in DIRECTIONS:
-            mesh_list = [(mesh_name(b, s, d, "big", state), mesh_name(b, s, d, "small", state), bpose, spose, bound)
-                         for b, s, bpose, spose, bound in pairs]
+            mesh_list = [(mesh_name(b, s, d, "big", variant), mesh_name(b, s, d, "small", ""), bpose, spose, bound)
+                         for b, s, bpose, spose, bound, variant in pairs]
             tasks.append((measure_contact, (exact[d][n].angle_rad, d, mesh_list, tol_rad)))
             owners.append([key + (d,) for key in keys])
-            weights.append(per_pair * len(pairs))
+            weights.append(len(pairs))
     range_tasks = _range_tasks(params, shims, template_shim, range_shims, angles_per_cycle, tasks, weights)
     setup = SweepSetup(
         params=params, layout=layout, bodies=bodies, states=states, shim_states=shim_states, thermal_at=thermal_at,
@@ -292,7 +383,7 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         bound_arcmin=bound_max_mm / d1_half * bp.ARCMIN_PER_RAD, pruned_meshes=len(meshes),
         pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started)
     return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
-                     weights=weights, unit="collide call",
+                     weights=weights, unit="contact",
                      options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
 
 
@@ -315,13 +406,13 @@ def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list
             for k, phi in enumerate(angles):
                 poses = drive_poses(built, bigs, smalls, specs.big, specs.small, phi, shim - template_shim)
                 placed = placed_gears(specs, poses, thermal)
-                mesh_pose = {n: thermal[n].cold_pose(poses[n]) for n in poses}
                 groups, twins = congruent_groups(placed, specs.big, specs.small, bigs, smalls)
                 reused += twins
                 for gb, gs, members in groups:
                     solve.append((placed[gb], placed[gs]))
                     pending.append(([(i, state, k, b, s) for b, s in members],
-                                    [(b, s, mesh_pose[b], mesh_pose[s], bound_mm[(b, s, state)] / d1_half)
+                                    [(b, s, *normalised_poses(thermal, b, s, poses[b], poses[s])[:2],
+                                      bound_mm[(b, s, state)] / d1_half, mesh_variant(thermal, b, s, state))
                                      for b, s in members]))
     t0 = time.perf_counter()
     exact = {d: bp.big_gear_contacts([p[0] for p in solve], [p[1] for p in solve], d) for d in DIRECTIONS}

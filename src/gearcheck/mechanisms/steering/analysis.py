@@ -21,7 +21,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
 from gearcheck.geometry.rack_pinion_power import phi_power_conjugate_end
@@ -34,6 +33,7 @@ from gearcheck.mechanisms.steering.push import (  # noqa: F401  (re-exported: th
     TRAVEL_TOL_MM,
     Sweep,
     Towing,
+    all_intervals,
     analyse_towing,
     overlap_intervals,
     pair_push_interval,
@@ -305,7 +305,7 @@ def solve_trims(g: RackPinionGeometry, min_contact_ratio: float, target_angle: f
         return phi_towing_conjugate_end(g, j, radius) - target_angle
 
     lo, hi = g.form_radius + 1e-9, g.tip_radius
-    rs1 = float(brentq(s1_miss, lo, hi, xtol=1e-12)) if s1_miss(lo) < 0 < s1_miss(hi) else math.nan
+    rs1 = float(_brentq()(s1_miss, lo, hi, xtol=1e-12)) if s1_miss(lo) < 0 < s1_miss(hi) else math.nan
 
     hS2 = math.nan
     if math.isfinite(rs1):
@@ -315,7 +315,7 @@ def solve_trims(g: RackPinionGeometry, min_contact_ratio: float, target_angle: f
         h_lo = max(g.rolling_line_height, H - rs1) + 1e-9
         h_hi = g.rack_top_height
         if h_lo < h_hi and travel_miss(h_lo) < 0 < travel_miss(h_hi):
-            hS2 = float(brentq(travel_miss, h_lo, h_hi, xtol=1e-12))
+            hS2 = float(_brentq()(travel_miss, h_lo, h_hi, xtol=1e-12))
 
     machined_travel = travel_corner_on_circle(g, first + 1, g.hS4_mm, g.tip_radius)
     x_s1 = machined_travel + first * g.pitch - float(g.rack_half_width(g.hS2_mm))
@@ -329,3 +329,11 @@ def towing_curve(params, step_deg: float = ANGLE_STEP_DEG) -> tuple[np.ndarray, 
     g = geometry_from_params(params)
     t = analyse_towing(g, params.towing.max_angle_deg, step_deg)
     return t.forward.phi_deg, t.forward.travel_mm, t.back.travel_mm[::-1]
+
+
+def _brentq():
+    """scipy's root finder, imported when first needed (sweep workers import this module and never
+    call it)."""
+    from scipy.optimize import brentq
+
+    return brentq

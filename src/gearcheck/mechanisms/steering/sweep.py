@@ -122,7 +122,12 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
          ) -> SweepPlan:
     """Towing (both swings, both directions) and power mode on the built meshes; ``options``:
     ``towing_step_deg``, ``power_step_deg`` (grid steps, degrees of pinion angle)."""
-    from gearcheck.mechanisms.steering.tasks import Kinematics, power_task, towing_task  # the tasks import FCL
+    from gearcheck.mechanisms.steering.tasks import (  # the tasks import FCL
+        Kinematics,
+        power_task,
+        rest_meshes,
+        towing_tasks,
+    )
 
     t_start = time.perf_counter()
     opts = dict(OPTIONS)
@@ -147,6 +152,7 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     centre_height = kin.centre_height_mm
     flanks = ms.rack_flank_faces(g, rack.mesh)
     meshes, mesh_info = ms.sweep_meshes(pinion, rack, centre_height, flanks)
+    meshes += rest_meshes(next(m for m in meshes if m.name == RACK), g)
     tip = float(np.hypot(pinion.mesh.vertices[:, 0], pinion.mesh.vertices[:, 1]).max())
     rack_top = float(rack.mesh.vertices[:, 1].max())
     corner = layout.s6_corner
@@ -172,14 +178,19 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     reach_angle_per_mm = REACH_MARGIN / (centre_height - rack_top)
 
     mirror = np.array([-1.0, 1.0])
-    tasks: list[Task] = [(towing_task, (kin, d, angles, tol, reach_travel_per_rad, limit)) for d in (+1, -1)]
-    tasks += [(power_task, (kin, d, travels, tol, reach_angle_per_mm, limit, profile, corner * m, normal * m,
-                            up * m, g.pitch))
-              for d, m in ((+1, np.ones(2)), (-1, mirror))]
-    weights = [2 * len(angles)] * 2 + [len(travels)] * 2  # poses per task
+    # Power mode one task per direction, towing both directions in one: an executor that works in
+    # this process too sends the first tasks to its workers and takes the last itself while they
+    # start, so the longer towing swings go to the process that starts at once, and no worker that
+    # finished early takes the second swing from it (only the wall time changes; reduce puts the
+    # results in the order towing +, towing −, power +, power −).
+    tasks: list[Task] = [(power_task, (kin, d, travels, tol, reach_angle_per_mm, limit, profile, corner * m,
+                                       normal * m, up * m, g.pitch))
+                         for d, m in ((+1, np.ones(2)), (-1, mirror))]
+    tasks.append((towing_tasks, (kin, (+1, -1), angles, tol, reach_travel_per_rad, limit)))
+    weights = [len(travels)] * 2 + [4 * len(angles)]  # poses per task
 
-
-    def reduce(results: list) -> SweepOutcome:
+    def reduce(sent: list) -> SweepOutcome:
+        results = [*sent[2], sent[0], sent[1]]
         drives = _mesh_drives(g, kin, flank_pairs, results)
         return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives)
 
@@ -208,8 +219,16 @@ def _towing_rows(g: RackPinionGeometry, tow: dict) -> tuple[list[dict], dict, di
     """Rows of both towing swings with the push model's travel at the same angles."""
     rows, deviation, curves = [], {}, {}
     for d, r in tow.items():
-        out = an.sweep(g, r["angles_out"], 0.0, d)
-        back = an.sweep(g, r["angles_back"], float(out.travel_mm[-1]), -d)
+        out_phis, back_phis = np.asarray(r["angles_out"], float), np.asarray(r["angles_back"], float)
+        if np.array_equal(back_phis, out_phis[::-1]):  # the return swing retraces the poses: intervals once
+            pairs, whole, left, right = an.all_intervals(g, out_phis)
+            push_out, push_back = (left, right) if d > 0 else (right, left)
+            out = an.sweep(g, out_phis, 0.0, d, (pairs, *push_out, *whole))
+            back = an.sweep(g, back_phis, float(out.travel_mm[-1]), -d,
+                            (pairs, push_back[0][:, ::-1], push_back[1][:, ::-1], whole[0][:, ::-1], whole[1][:, ::-1]))
+        else:
+            out = an.sweep(g, out_phis, 0.0, d)
+            back = an.sweep(g, back_phis, float(out.travel_mm[-1]), -d)
         curves[d] = {"out": out.travel_mm, "back": back.travel_mm}
         dev = []
         for swing in ("out", "back"):

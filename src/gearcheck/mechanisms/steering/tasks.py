@@ -20,17 +20,18 @@ it back the same way. Events, each by bisection between grid poses:
   contact (the no-interference claim comes with the pose where contact is reached).
 
 **Power** (the rack drives): the rack advances; the pinion turns by the smallest angle that clears
-the rack's driving flanks (bisection on the pinion angle). The continuous-drive limit is where the
-driving contact on the first rack tooth reaches its top corner S6 (eq 19): a contact *position*,
-linear in the angle, never a threshold on the lag behind the conjugate ratio (that lag grows with
-the square of the overshoot and hides below the mesh error). The FCL nearest points locate the
-contact; because the pinion mesh is a polygon (vertices on the exact flank, chords inside it), the
-raw nearest point sits on a mesh vertex and jumps by a chord (~1 mm along the flank) — and near
-the corner the vertex/flank and corner/chord contacts, whose exact versions are tangent there,
+the rack's driving flanks (bisection on the pinion angle, replayed around where one distance query
+expects the contact and proven from both sides: :func:`_bisect_move`). The continuous-drive limit is
+where the driving contact on the first rack tooth reaches its top corner S6 (eq 19): a contact
+*position*, linear in the angle, never a threshold on the lag behind the conjugate ratio (that lag
+grows with the square of the overshoot and hides below the mesh error). The FCL nearest points
+locate the contact; because the pinion mesh is a polygon (vertices on the exact flank, chords inside
+it), the raw nearest point sits on a mesh vertex and jumps by a chord (~1 mm along the flank) — and
+near the corner the vertex/flank and corner/chord contacts, whose exact versions are tangent there,
 swap within the mesh error, so the raw point reaches the corner up to ~1° early or late. The
 position is therefore taken as the tangency point of the flank the mesh vertices describe
-(:func:`gearcheck.geometry.rack_pinion_power.tangency_offset`). The limit is the travel where
-that point reaches S6 (bisection on L); the raw corner contact is reported beside it.
+(:func:`gearcheck.geometry.rack_pinion_power.tangency_offset`). The limit is the travel where that
+point reaches S6 (bisection on L); the raw corner contact is reported beside it.
 
 **Interference**: at every pose the whole walls are tested. Zero backlash means the non-driving
 flanks touch at zero clearance too, so a collision is measured, not just flagged: the rack shift
@@ -43,29 +44,39 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.geometry.bisect import bisect
+from gearcheck.geometry.bisect import Bracket, bisect, bisect_predicted
 from gearcheck.geometry.rack_pinion_power import tangency_offset
 from gearcheck.mechanism import Assembly
-from gearcheck.mechanisms.steering.meshes import PINION, RACK, pusher
+from gearcheck.geometry.rack_pinion import RackPinionGeometry
+from gearcheck.mechanisms.steering.meshes import (
+    PINION,
+    RACK,
+    RACK_FACING_MINUS_X,
+    RACK_FACING_PLUS_X,
+    pusher,
+    rack_flank_faces,
+)
+from gearcheck.sweep.bodies import MeshData, submesh
 from gearcheck.sweep.engine import Scene
 from gearcheck.sweep.motion import Rotation, Translation
-from gearcheck.sweep.tools import (
-    CountedScene,
-    clearing_distance,
-    contact_distance,
-    extrapolated_event,
-    smallest_clearing_move,
-)
+from gearcheck.sweep.tools import REACH_SAMPLES, CountedScene, clearing_distance, contact_distance, extrapolated_event
+
+# The swept rack without the flanks named (those just bisected to contact): meshes of :func:`rest_meshes`.
+REST_OF = {RACK_FACING_MINUS_X: "rack_but_left_flanks", RACK_FACING_PLUS_X: "rack_but_right_flanks"}
 
 # Bisection tolerances.
 TRAVEL_BISECT_TOL_MM = 1e-4  # rack travel where a pushed rack just clears the pinion (1/500 of the curve tolerance)
 ANGLE_BISECT_TOL_RAD = 1e-8  # pinion angle where a driven pinion just clears the rack (1e-6 mm at r)
 EVENT_ANGLE_TOL_RAD = 1e-7  # disengage / grazing end / re-engage angles
 EVENT_TRAVEL_TOL_MM = 1e-5  # travel where the power-mode contact reaches S6
+# Where one distance query puts the contact, the replayed halving asks the collide flag only within
+# these margins (bisection tolerances) of it, each tried in turn, before the plain bisection.
+ESTIMATE_MARGINS_TOL = (2.0, 160.0)
 
 
 @dataclass(frozen=True)
@@ -101,18 +112,32 @@ class Kinematics:
 
 
 class _Probe:
-    """The counted scene with the pinion/rack poses set from angle and travel."""
+    """The counted scene with the pinion/rack poses set from angle and travel. A body already
+    at the asked angle or travel (the same bits) is left where it is: a bisection on the travel
+    keeps the pinion's pose, one on the angle the rack's (the same transform, not recomputed)."""
 
     def __init__(self, scene: Scene, kin: Kinematics):
         self.scene, self.kin = CountedScene(scene), kin
+        self._at: dict[str, str] = {}  # body → the angle or travel it is posed at (float.hex)
 
     @property
     def queries(self) -> int:
         return self.scene.queries
 
     def place(self, angle: float, travel: float, rack_mesh: str = RACK) -> None:
-        self.scene.set_pose(PINION, self.kin.pinion(angle))
-        self.scene.set_pose(rack_mesh, self.kin.rack(travel))
+        key = float(angle).hex()
+        if self._at.get(PINION) != key:
+            self.scene.set_pose(PINION, self.kin.pinion(angle))
+            self._at[PINION] = key
+        key = float(travel).hex()
+        if self._at.get(rack_mesh) != key:
+            self.scene.set_pose(rack_mesh, self.kin.rack(travel))
+            self._at[rack_mesh] = key
+
+    def set_pose(self, name: str, pose: np.ndarray) -> None:
+        """A pose not given by angle or travel."""
+        self.scene.set_pose(name, pose)
+        self._at.pop(name, None)
 
     def hits(self, angle: float, travel: float, rack_mesh: str = RACK) -> bool:
         self.place(angle, travel, rack_mesh)
@@ -121,6 +146,61 @@ class _Probe:
     def distance(self, angle: float, travel: float, rack_mesh: str = RACK):
         self.place(angle, travel, rack_mesh)
         return self.scene.distance(PINION, rack_mesh)
+
+    def turn_to_contact(self, angle: float, travel: float, rack_mesh: str, sense: int, free: float) -> float | None:
+        """Where the pinion's turn, ``free`` (towards ``sense``) at this free pose, reaches contact
+        with the rack, from one distance query: the gap d between the nearest points p (pinion) and q
+        (rack) opens at the rate s = −sense·n·(a × (p − o)) per radian of turn (n the unit normal
+        from p to q, a and o the pinion's axis and origin), so contact is expected d / s back. An
+        estimate only (None when the walls touch or the gap does not close that way): the contact
+        is proven by collisions (:func:`_bisect_move`)."""
+        near = self.distance(angle, travel, rack_mesh)
+        gap = near.point_b - near.point_a
+        d = float(np.linalg.norm(gap))
+        if not d > 0.0:
+            return None
+        motion = self.kin.pinion_motion
+        axis, origin = np.asarray(motion.axis, float), np.asarray(motion.origin, float)
+        rate = -sense * float(np.dot(gap / d, np.cross(axis, near.point_a - origin)))
+        if not rate > 0.0:
+            return None
+        return free - d / rate
+
+
+def _clearing_move(hits_at: Callable[[float], bool], reach: float, predicted: float, tol: float,
+                   estimate_at: Callable[[float], float | None] | None = None) -> float | None:
+    """:func:`gearcheck.sweep.tools.smallest_clearing_move`, the same move bit for bit in fewer
+    collide calls: the same first bracket (around ``predicted`` when it holds, else between the
+    last colliding and the first free of the reach's samples), then :func:`_bisect_move`."""
+    if predicted > 0.0:
+        near, far = max(0.995 * predicted - 2e-4, 0.0), 1.005 * predicted + 2e-4
+        if far <= reach and not hits_at(far) and (near == 0.0 or hits_at(near)):
+            return _bisect_move(hits_at, far, near, tol, estimate_at).free
+    previous = 0.0
+    for i in range(1, REACH_SAMPLES + 1):
+        d = reach * i / REACH_SAMPLES
+        if not hits_at(d):
+            return _bisect_move(hits_at, d, previous, tol, estimate_at).free
+        previous = d
+    return None
+
+
+def _bisect_move(hits_at: Callable[[float], bool], free: float, touching: float, tol: float,
+                 estimate_at: Callable[[float], float | None] | None) -> Bracket:
+    """The bracket the plain bisection ends with from [free, touching] (both ends already asked:
+    free, colliding). With ``estimate_at`` (where one distance query at the free end expects the
+    contact) lying strictly inside the bracket, :func:`gearcheck.geometry.bisect.bisect_predicted`
+    replays the same halving, asks only the midpoints within a margin of the estimate and proves
+    the final bracket from both sides; where the flag changes once over the bracket (the contact
+    of a part moving into another) that is the plain bisection's bracket, bit for bit. When the
+    estimate misses (no proven bracket within any margin) the plain bisection runs."""
+    estimate = estimate_at(free) if estimate_at is not None else None
+    if estimate is not None and min(free, touching) < estimate < max(free, touching):
+        for m in ESTIMATE_MARGINS_TOL:
+            found = bisect_predicted(hits_at, free, touching, tol, estimate, m * tol)
+            if found is not None:
+                return found[0]
+    return bisect(hits_at, free, touching, tol, check_ends=False)
 
 
 def _push_rack(probe: _Probe, angle: float, travel: float, sense: int, reach: float,
@@ -131,8 +211,9 @@ def _push_rack(probe: _Probe, angle: float, travel: float, sense: int, reach: fl
     faces = pusher(sense)
     if not probe.hits(angle, travel, faces):
         return travel, False
-    move = smallest_clearing_move(lambda d: probe.hits(angle, travel + sense * d, faces), reach, predicted,
-                                  TRAVEL_BISECT_TOL_MM)
+    # no distance estimate: the bracket is a few tolerances wide, a distance query costs more than it saves
+    move = _clearing_move(lambda d: probe.hits(angle, travel + sense * d, faces), reach, predicted,
+                          TRAVEL_BISECT_TOL_MM)
     return (travel, False) if move is None else (travel + sense * move, True)
 
 
@@ -144,19 +225,35 @@ def _turn_pinion(probe: _Probe, angle: float, travel: float, sense: int, reach: 
     faces = pusher(-sense)
     if not probe.hits(angle, travel, faces):
         return angle, False
-    move = smallest_clearing_move(lambda d: probe.hits(angle + sense * d, travel, faces), reach, predicted,
-                                  ANGLE_BISECT_TOL_RAD)
+
+    def estimate_at(d: float) -> float | None:
+        return probe.turn_to_contact(angle + sense * d, travel, faces, sense, d)
+
+    move = _clearing_move(lambda d: probe.hits(angle + sense * d, travel, faces), reach, predicted,
+                          ANGLE_BISECT_TOL_RAD, estimate_at)
     return (angle, False) if move is None else (angle + sense * move, True)
 
 
+def rest_meshes(rack: MeshData, g: RackPinionGeometry) -> list[MeshData]:
+    """The swept rack (``rack``, the :data:`RACK` mesh) without its left flanks, and without its
+    right flanks: :data:`REST_OF` names them by the flanks left out."""
+    left, right = rack_flank_faces(g, rack)
+    return [submesh(rack, REST_OF[RACK_FACING_MINUS_X], ~left), submesh(rack, REST_OF[RACK_FACING_PLUS_X], ~right)]
+
+
 def signed_clearance(probe: _Probe, angle: float, travel: float, tol: float, limit: float,
-                     in_contact: bool = False) -> float:
+                     in_contact: str | None = None) -> float:
     """Mesh distance between the walls when clear (0 when ``in_contact``: the pose was just
-    bisected to contact, so the distance is within the bisection tolerance and is not measured
-    again); when they collide, minus the depth measured as the rack shifts along its travel that
-    clear the left- and the right-facing flanks (an upper bound of the normal depth), or, for a
-    hit on faces that do not face the travel (tops), the drop of the rack that clears it."""
-    if not probe.hits(angle, travel):
+    bisected to contact with those rack faces, so the distance is within the bisection tolerance
+    and is not measured again). The bisection proved those faces free at this very pose (its free
+    end was asked), so the whole rack collides exactly when the rest of it does
+    (:func:`rest_meshes`): a mesh collides when one of its triangles crosses one of the other's,
+    and the faces split the rack's triangles in two — the rest is asked alone, a smaller BVH
+    that does not descend to the contact just bisected. When they collide, minus the depth
+    measured as the rack shifts along its travel that clear the left- and the right-facing flanks
+    (an upper bound of the normal depth), or, for a hit on faces that do not face the travel
+    (tops), the drop of the rack that clears it."""
+    if not (probe.hits(angle, travel, REST_OF[in_contact]) if in_contact else probe.hits(angle, travel)):
         return 0.0 if in_contact else probe.distance(angle, travel).distance
     depth = 0.0
     for sense in (+1, -1):
@@ -170,10 +267,10 @@ def signed_clearance(probe: _Probe, angle: float, travel: float, tol: float, lim
         kin = probe.kin
 
         def hits_lowered(d: float) -> bool:
-            probe.scene.set_pose(PINION, kin.pinion(angle))
+            probe.set_pose(PINION, kin.pinion(angle))
             pose = kin.rack(travel)
             pose[1, 3] -= d
-            probe.scene.set_pose(RACK, pose)
+            probe.set_pose(RACK, pose)
             return probe.scene.collide(PINION, RACK)
 
         depth = clearing_distance(hits_lowered, tol, limit, TRAVEL_BISECT_TOL_MM)
@@ -190,7 +287,7 @@ def _swing(probe: _Probe, angles: np.ndarray, travel: float, sense: int, reach_r
         rate = abs(travel - before) / step if moved and step > 0 else 0.0
         travels.append(travel)
         pushed.append(moved)
-        clearance.append(signed_clearance(probe, float(angle), travel, tol, limit, moved))
+        clearance.append(signed_clearance(probe, float(angle), travel, tol, limit, pusher(sense) if moved else None))
     return np.array(travels), np.array(pushed), np.array(clearance)
 
 
@@ -259,6 +356,12 @@ def towing_task(scene: Scene, kin: Kinematics, direction: int, angles: np.ndarra
     }
 
 
+def towing_tasks(scene: Scene, kin: Kinematics, directions: tuple[int, ...], angles: np.ndarray, tol: float,
+                 reach_rate: float, limit: float) -> list[dict]:
+    """:func:`towing_task` in each direction in turn, as one task (run by one process)."""
+    return [towing_task(scene, kin, d, angles, tol, reach_rate, limit) for d in directions]
+
+
 def power_task(scene: Scene, kin: Kinematics, direction: int, travels: np.ndarray, tol: float, reach_rate: float,
                limit: float, profile: np.ndarray, corner: np.ndarray, normal: np.ndarray, up: np.ndarray,
                pitch: float) -> dict:
@@ -289,7 +392,7 @@ def power_task(scene: Scene, kin: Kinematics, direction: int, travels: np.ndarra
         angle, moved = _turn_pinion(probe, angle, float(travel), direction, reach_rate * (step + tol), rate * step)
         rate = abs(angle - before) / step if moved and step > 0 else 0.0
         angles.append(angle)
-        clear.append(signed_clearance(probe, angle, float(travel), tol, limit, moved))
+        clear.append(signed_clearance(probe, angle, float(travel), tol, limit, faces if moved else None))
         offset, at_corner = math.nan, False
         if abs(corner_at(float(travel))[0]) < 2.0 * pitch:  # the first rack tooth is in mesh
             d, offset, at_corner = contact(angle, float(travel))

@@ -50,16 +50,39 @@ def worn_model(model: TrackModel) -> TrackModel | None:
     return dataclasses.replace(model, wrap=track_wear.worn_wrap(w.teeth, w.pitch_mm, model.wear_elongation, w))
 
 
+# The exact tables of the last few (model, angles) asked for in this process: the plan's smallest
+# clearance and the sweep's reduce ask for the same ones (new chain and worn chain).
+_TABLE_CACHE: dict = {}
+_TABLE_CACHE_SIZE = 4
+
+
+def exact_table(model: TrackModel, angles: np.ndarray) -> np.ndarray:
+    """(angles, links, 2): the exact tooth–sleeve clearance and tip-to-plate distance (mm) of every
+    link of the wrap at every sprocket angle, :meth:`ExactSection.link_distances` pose by pose.
+    Computed once per process for a model and its angles: the plan's smallest clearance, the
+    sweep's comparison with the meshes and its exact figures are all read from the same table."""
+    angles = np.asarray(angles, dtype=float)
+    key = (model.key(), angles.tobytes())
+    table = _TABLE_CACHE.get(key)
+    if table is None:
+        exact = exact_section(model)
+        table = np.empty((len(angles), model.wrap.links, 2))
+        for i, a in enumerate(angles):
+            sprocket = tc.sprocket_matrix(float(a))
+            for j, pose in enumerate(model.wrap.link_matrices(float(a))):
+                table[i, j] = exact.link_distances(sprocket, pose)
+        table.setflags(write=False)
+        if len(_TABLE_CACHE) >= _TABLE_CACHE_SIZE:
+            _TABLE_CACHE.pop(next(iter(_TABLE_CACHE)))
+        _TABLE_CACHE[key] = table
+    return table
+
+
 def exact_extremes(model: TrackModel, angles: np.ndarray) -> tuple[float, float]:
     """The least exact tooth–sleeve clearance and tip-to-plate distance (mm) over the angles and
     every link of the wrap (negative: the exact sections overlap)."""
-    exact = exact_section(model)
-    least = np.array([np.inf, np.inf])
-    for a in angles:
-        sprocket = tc.sprocket_matrix(float(a))
-        for pose in model.wrap.link_matrices(float(a)):
-            least = np.minimum(least, exact.link_distances(sprocket, pose))
-    return float(least[0]), float(least[1])
+    table = exact_table(model, angles)
+    return float(table[..., 0].min()), float(table[..., 1].min())
 
 
 def clearance_of(min_sleeve_mm: float, min_plate_mm: float, where: str = "") -> Clearance | None:

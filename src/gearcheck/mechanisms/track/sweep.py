@@ -40,7 +40,7 @@ from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
 from gearcheck.mechanisms.track import wear as track_wear
 from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
 from gearcheck.mechanisms.track.clearance import (CYCLE_MARGIN_FRACTION, STEPS_PER_CYCLE, exact_section,
-                                                  sweep_angles, worn_model)
+                                                  exact_table, sweep_angles, worn_model)
 from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
 from gearcheck.sweep.engine import Scene
@@ -58,6 +58,9 @@ BISECTION_TOL_MM = 1e-5
 # A link-mesh triangle belongs to the sleeve when all its vertices lie within R + this of the pin
 # axis (mesh vertices lie on the B-rep surfaces; plate triangles reach out to the plate's far edges).
 SLEEVE_SELECT_MARGIN_MM = 1e-4
+# A link whose sleeve and plate both lie farther than this (mm) from the sprocket cannot intersect it
+# (FCL's distance is 0 between surfaces that meet; 1 µm is far above its rounding at this size).
+COLLIDE_SKIP_MM = 1e-3
 # Rounding of measured values against the paper's window (report precision, 1 µm).
 WINDOW_ROUNDING_MM = 1e-6
 
@@ -84,20 +87,26 @@ def split_link_mesh(mesh: MeshData, sleeve_radius_mm: float,
 # The task (runs in worker processes)
 
 def evaluate_pose(scene: Scene, model: TrackModel, angle_rad: float) -> np.ndarray:
-    """(links, 5) per link at drive angle θ: mesh sprocket–sleeve distance, mesh sprocket–plate
-    distance (mm), whether the sprocket and the whole link mesh intersect (1/0), and the exact
-    2-D sleeve clearance and plate distance at the same pose."""
-    exact = exact_section(model)
+    """(links, 3) per link at drive angle θ: mesh sprocket–sleeve distance, mesh sprocket–plate
+    distance (mm), and whether the sprocket and the whole link mesh intersect (1/0).
+
+    The intersection test runs only where the sleeve or the plate comes within
+    :data:`COLLIDE_SKIP_MM` of the sprocket: the link's surface is the sleeve's triangles and the
+    plate's (:func:`split_link_mesh` parts them), and FCL's distance is 0 between surfaces that
+    meet, so a link farther than that from the sprocket cannot intersect it (the test would say
+    no). The exact 2-D figures of the same poses are computed once, in the process that plans
+    and reduces (:func:`.clearance.exact_table`)."""
     sprocket = tc.sprocket_matrix(angle_rad)
     scene.set_pose(SPROCKET, sprocket)
     poses = model.wrap.link_matrices(angle_rad)
-    out = np.empty((len(poses), 5))
+    out = np.zeros((len(poses), 3))
     for j, pose in enumerate(poses):
-        scene.set_poses({SLEEVE: pose, PLATE: pose, LINK: pose})
+        scene.set_poses({SLEEVE: pose, PLATE: pose})
         out[j, 0] = scene.distance(SPROCKET, SLEEVE).distance
         out[j, 1] = scene.distance(SPROCKET, PLATE).distance
-        out[j, 2] = scene.collide(SPROCKET, LINK)
-        out[j, 3:] = exact.link_distances(sprocket, pose)
+        if not (out[j, 0] > COLLIDE_SKIP_MM and out[j, 1] > COLLIDE_SKIP_MM):  # (a NaN would be tested)
+            scene.set_pose(LINK, pose)
+            out[j, 2] = scene.collide(SPROCKET, LINK)
     return out
 
 
@@ -319,11 +328,12 @@ class WornMesh:
     max_dev: float
 
 
-def _worn_mesh(results: list, reach_mm: float) -> WornMesh | None:
-    if not results:
+def _worn_mesh(results: list, exact: np.ndarray | None, reach_mm: float) -> WornMesh | None:
+    if not results or exact is None:
         return None
     out = np.array(results)
-    sleeve_d, plate_d, hits, ex_sleeve, ex_plate = (out[..., k] for k in range(5))
+    sleeve_d, plate_d, hits = (out[..., k] for k in range(3))
+    ex_sleeve, ex_plate = exact[..., 0], exact[..., 1]
     dev_sleeve = np.abs(np.where(sleeve_d < reach_mm / 2, sleeve_d - ex_sleeve, 0.0))
     dev_plate = np.abs(np.where(plate_d < reach_mm / 2, plate_d - ex_plate, 0.0))
     return WornMesh(len(out), int((hits > 0.5).sum()), float(sleeve_d.min()), float(plate_d.min()),
@@ -336,9 +346,15 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     sweep_s = time.perf_counter() - setup.started
     model, angles, names, bound = setup.model, setup.angles, setup.names, setup.bound
     wrap = model.wrap
-    out = np.array(results[:len(angles)])  # (poses, links, 5)
+    out = np.array(results[:len(angles)])  # (poses, links, 3)
     sleeve_d, plate_d, hits = out[..., 0], out[..., 1], out[..., 2] > 0.5
-    ex_sleeve, ex_plate = out[..., 3], out[..., 4]
+    table = exact_table(model, angles)  # (poses, links, 2), as the plan's smallest clearance read it
+    ex_sleeve, ex_plate = table[..., 0], table[..., 1]
+    tables = [(model.wrap, angles, table)]
+    worn_table = None
+    if setup.worn_model is not None:
+        worn_table = exact_table(setup.worn_model, angles)
+        tables.append((setup.worn_model.wrap, angles, worn_table))
     exact = exact_section(model)
     pins_seated = np.array([wrap.seated_pins(a) for a in angles])
     links_seated = pins_seated[:, :-1] & pins_seated[:, 1:]
@@ -365,8 +381,8 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
                       sleeve_seated, x, seated_gap_max, max_dev, bound, setup.contact_tol, gap_proof, sleeve_proof,
                       gap_point_link, float(whole_link_at_sleeve), model_gap, len(setup.meshes[1].faces),
                       len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s,
-                      wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation),
-                      worn_mesh=_worn_mesh(results[len(angles):], exact.reach_mm))
+                      wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation, tables=tables),
+                      worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm))
     worst = [
         WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
                   names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),

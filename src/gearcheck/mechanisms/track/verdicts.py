@@ -29,9 +29,9 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     # a mesh collision at a clearance the meshes cannot resolve is not evidence: the exact model decides
     resolved = outcome.mesh_resolves
     no_interference = (collisions == 0 or not resolved) and not exact_penetration
-    on_mesh = ("mesh sweep (FCL collide at every link pose), exact 2-D model agrees" if resolved else
-               "exact model (2-D section): the meshes cannot resolve the least clearance; exact B-rep at the "
-               "worst poses")
+    on_mesh = ("mesh sweep (FCL at every link pose: distances, collide within 1 µm), exact 2-D model agrees"
+               if resolved else "exact model (2-D section): the meshes cannot resolve the least clearance; "
+               "exact B-rep at the worst poses")
     gap_in_window = (rounded(seated_gap.value) >= model.required_gap_min_mm
                      and rounded(d.seated_gap_max) <= model.required_gap_max_mm)
     min_plate_ok = rounded(min_plate.value) >= model.required_gap_min_mm
@@ -39,7 +39,8 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     worn_dev = d.worn_mesh.max_dev if d.worn_mesh is not None else 0.0
     agrees = max(d.max_dev, worn_dev) <= bound
     clash = (f"{collisions} colliding link poses, first at θ = {np.degrees(angles[d.colliding_poses[0]]):.3f}°; "
-             if collisions else f"FCL collide false at all {len(angles)}×{model.wrap.links} link poses; ")
+             if collisions else f"no intersection at any of the {len(angles)}×{model.wrap.links} link poses (FCL: "
+             "distance > 1 µm, else collide false); ")
     kind = ("a positive clearance beyond the bound" if min_sleeve.value > bound
             else "within the bound: a contact, not a resolved clearance")
     least_exact = min(ex_min_sleeve.value, ex_min_plate.value)

@@ -1,0 +1,156 @@
+"""The differential's mesh contacts found in few FCL queries are the plain bisection's, bit for bit.
+
+Two shortcuts are checked here against the slow path they replace: the halving replayed around an
+estimate (a congruent pair's contact, or a distance query's), and every thermal state sharing the
+meshes as built (a uniform scale of the world changes no contact).
+"""
+
+from __future__ import annotations
+
+import math
+import random
+
+import numpy as np
+import pytest
+
+from gearcheck.geometry.bisect import bisect, bisect_predicted
+
+
+def test_replayed_halving_is_the_plain_bisection():
+    rng = random.Random(7)
+    for _ in range(400):
+        lo, hi = sorted(rng.uniform(-5.0, 5.0) for _ in range(2))
+        threshold = rng.uniform(lo, hi)
+        tol = 10 ** rng.uniform(-9, -3)
+        flip = rng.random() < 0.5  # touching end below as well as above
+        free, touching = (hi, lo) if flip else (lo, hi)
+        asked = []
+
+        def flag(x: float, t=threshold, f=flip, a=asked) -> bool:
+            a.append(x)
+            return x <= t if f else x >= t
+
+        plain = bisect(flag, free, touching, tol, check_ends=False)
+        plain_calls = len(asked)
+        # a good estimate: the same bracket, and only a few calls
+        margin = tol
+        found = bisect_predicted(flag, free, touching, tol, threshold + rng.uniform(-0.5, 0.5) * tol, margin)
+        assert found is not None
+        bracket, calls = found
+        assert (bracket.free, bracket.touching) == (plain.free, plain.touching)
+        assert calls <= 6 and (calls < plain_calls or plain_calls <= 6)
+        # a wrong estimate: no bracket is made up (None), or the one found is proven and still exact
+        wrong = bisect_predicted(flag, free, touching, tol, threshold + rng.choice((-1, 1)) * 50 * tol, tol)
+        if wrong is not None:
+            assert (wrong[0].free, wrong[0].touching) == (plain.free, plain.touching)
+
+
+def test_a_proven_bracket_holds_even_when_the_flag_is_not_monotone():
+    # two contacts: flag true on [1, 2] and beyond 3; an estimate near 3 proves a real change there
+    def flag(x: float) -> bool:
+        return 1.0 <= x <= 2.0 or x >= 3.0
+
+    found = bisect_predicted(flag, 2.5, 4.0, 1e-6, 3.0, 1e-6)
+    assert found is not None
+    bracket, _ = found
+    assert not flag(bracket.free) and flag(bracket.touching) and bracket.width <= 1e-6
+
+
+@pytest.fixture(scope="module")
+def plan_and_run(build_bodies):
+    run = build_bodies("zhurong_differential")
+    design = run.design
+    options = {"angles_per_cycle": 2, "shims_mm": [0.0], "range_shims": "template"}
+    plan = design.impl.plan(design.params, run.assembly, run.bodies, options)
+    return run, plan
+
+
+def _contacts(plan, scene, limit):
+    from gearcheck.mechanisms.differential import sweep as ds
+
+    out = []
+    for fn, args in plan.tasks:
+        if fn is ds.measure_contact:
+            out.append(fn(scene, *args))
+            if len(out) == limit:
+                break
+    return out
+
+
+def test_estimated_contacts_are_the_plain_bisections(plan_and_run, monkeypatch):
+    from gearcheck.mechanisms.differential import sweep as ds
+    from gearcheck.sweep.plan import make_scene
+
+    _, plan = plan_and_run
+    scene = make_scene(plan.meshes)
+    fast = _contacts(plan, scene, 24)
+    # the slow path: no distance estimate, no hint from a congruent pair
+    monkeypatch.setattr(ds, "NEWTON_MARGINS_TOL", ())
+    original = ds._bisect_mesh
+    monkeypatch.setattr(ds, "_bisect_mesh", lambda *a, **k: original(*a[:9]))
+    slow = _contacts(plan, scene, 24)
+    found_by = set()
+    calls = [0, 0]
+    for f, s in zip(fast, slow, strict=True):
+        for mf, ms in zip(f["mesh"], s["mesh"], strict=True):
+            assert (mf["free_rad"], mf["touching_rad"], mf["widened"], mf["centred_collides"]) == \
+                   (ms["free_rad"], ms["touching_rad"], ms["widened"], ms["centred_collides"])
+            assert ms["found_by"] == "bisection"
+            if mf["found_by"] != "bisection":  # else the estimate missed: the plain path ran
+                assert mf["calls"] < ms["calls"]
+            found_by.add(mf["found_by"])
+            calls[0] += mf["calls"]
+            calls[1] += ms["calls"]
+    assert {"hint", "distance"} <= found_by
+    assert calls[0] < 0.6 * calls[1]
+
+
+def test_shared_meshes_decide_contact_as_the_scaled_ones(plan_and_run):
+    """Every state's contact bracket, found on the meshes as built (world scaled by the small
+    gear's factor), holds on the gears scaled about their datums and posed as in that state."""
+    from gearcheck.geometry import bevel_play as bp
+    from gearcheck.mechanisms.differential import sweep as ds
+    from gearcheck.sweep.engine import Scene
+    from gearcheck.sweep.plan import make_scene
+
+    run, plan = plan_and_run
+    setup = plan.reduce.args[0]
+    scene = make_scene(plan.meshes)
+    scaled_states = 0
+    for (fn, args), owners in zip(plan.tasks, setup.owners, strict=False):
+        if fn is not ds.measure_contact:
+            continue
+        result = fn(scene, *args)
+        (i, state, _k, big, small, d) = owners[0]
+        thermal = setup.thermal_at[(setup.shims[i], state)]
+        tb, ts = thermal[big], thermal[small]
+        if tb.scale == 1.0:
+            continue
+        scaled_states += 1
+        # the same pair in the old form: each gear's vertices scaled about its datum, cold pose
+        mesh_big = ds.mesh_name(big, small, d, "big", "")
+        mesh_small = ds.mesh_name(big, small, d, "small", "")
+        by_name = {m.name: m for m in plan.meshes}
+        from gearcheck.sweep.bodies import Body
+
+        def scaled(name, th):
+            return Body(by_name[name], np.eye(4), 0.0).scaled(th.scale, th.datum_local).mesh
+
+        old = Scene([scaled(mesh_big, tb), scaled(mesh_small, ts)])
+        _, _, big_pose, small_pose, _ = args[2][0]
+        # undo the normalisation: the old poses are the cold poses of the datum-scaled meshes
+        phi_poses = {big: big_pose.copy(), small: small_pose.copy()}
+        for name, th in ((big, tb), (small, ts)):
+            phi_poses[name][:3, 3] *= ts.scale
+            shift = np.eye(4)
+            shift[:3, 3] = (1.0 - th.scale) * th.datum_local
+            phi_poses[name] = phi_poses[name] @ np.linalg.inv(shift)
+        old.set_pose(mesh_small, phi_poses[small])
+        m = result["mesh"][0]
+        for turn, expected in ((m["free_rad"], False), (m["touching_rad"], True)):
+            old.set_pose(mesh_big, phi_poses[big] @ bp.rot_z4(turn))
+            assert old.collide(mesh_big, mesh_small) is expected
+        if scaled_states >= 8:
+            break
+    assert scaled_states >= 8
+    assert math.isfinite(setup.bound_arcmin)
