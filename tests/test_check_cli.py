@@ -99,3 +99,21 @@ def test_jobs_must_be_a_whole_number_of_at_least_one(capsys, templates_dir):
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and "--jobs = 0: allowed a whole number ≥ 1" in err
+
+
+def test_check_all_side_by_side_writes_what_each_check_alone_writes(template_check, tmp_path, capsys):
+    """`check --all` on two processes runs the templates side by side (the finest mesh in this
+    process, the others in a worker, whose own sweeps then run in it): every run's summary.json and
+    sweep.csv are byte for byte those of the template checked alone on two processes, and the
+    terminal lists the verdicts in template order."""
+    from gearcheck.design import find_templates
+
+    _, paths = find_templates(None)
+    assert main(["check", "--all", "--jobs", "2", "--out", str(tmp_path)]) in (0, 1)
+    out = capsys.readouterr().out
+    names = [p.stem for p in paths]
+    assert [out.index(f" {n}: ") for n in names] == sorted(out.index(f" {n}: ") for n in names)
+    for name in names:
+        alone = template_check(name).folder
+        for file in ("summary.json", "sweep.csv"):
+            assert (tmp_path / name / file).read_bytes() == (alone / file).read_bytes(), (name, file)

@@ -53,7 +53,7 @@ from gearcheck import __version__  # noqa: E402
 if TYPE_CHECKING:
     from gearcheck.design import Design
     from gearcheck.pipeline import Bar, CheckRun
-    from gearcheck.terminal import Screen
+    from gearcheck.terminal import Checked, Screen
 
 class _Parser(argparse.ArgumentParser):
     def error(self, message: str):  # usage errors are bad input: exit 2, one line
@@ -354,13 +354,12 @@ def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | N
                               extra_files=extra_files)
 
 
-def _show_check(run: CheckRun, *extra: str) -> None:
+def _show_check(run: CheckRun | Checked, *extra: str) -> None:
     """The verdicts first, then any pointer lines, then what was written."""
-    from gearcheck.terminal import files_line, verdicts_view
+    from gearcheck.terminal import Checked, files_line, verdicts_view
 
-    design = run.build.design
-    _show(*verdicts_view(run.result, design.name, run.folder, _screen()), *extra,
-          files_line(run.folder, run.files, len(run.build.parts)))
+    c = run if isinstance(run, Checked) else Checked.of(run)
+    _show(*verdicts_view(c.result, c.name, c.folder, _screen()), *extra, files_line(c.folder, c.files, c.parts))
 
 
 def _print_json(objects: list[dict], every: bool) -> None:
@@ -368,22 +367,36 @@ def _print_json(objects: list[dict], every: bool) -> None:
     print(json.dumps({"runs": objects} if every else objects[0], indent=2, allow_nan=False))
 
 
+def _side_by_side(executor: Any, designs: list[Design], fn: Any, args_of: Any, verb: str) -> list:
+    """``fn(None, *args_of(i))`` for every template, side by side (one's single-core stages overlap
+    another's), in template order. The finest default mesh (the longest run) last in line: this
+    process takes it at once, with every core for its sweep; the spawned workers the others."""
+    order = sorted(range(len(designs)), key=lambda i: -float(designs[i].impl.mesh_tol_mm))
+    with _display() as bars, bars(verb, len(order), "template") as bar:
+        done = executor.map(fn, [args_of(i) for i in order], progress=bar.update)
+    return [r for _, r in sorted(zip(order, done, strict=True), key=lambda x: x[0])]
+
+
 def cmd_check(args) -> int:
-    from gearcheck.terminal import check_json
+    from gearcheck.executor import make_executor
+    from gearcheck.terminal import Checked, check_task
 
     designs = _templates_or_one(args)
     folders = _prepared_folders(args, designs)
-    runs = []
-    for d, folder in zip(designs, folders, strict=True):
-        runs.append(run := _check_one(d, folder, args.tol, args.jobs, args.overrides))
-        if not args.json:
-            _show_check(run)
+    executor = make_executor(args.jobs)
+    if executor.jobs > 1 and len(designs) > 1:
+        runs = _side_by_side(executor, designs, check_task,
+                             lambda i: (designs[i], folders[i], args.tol, args.overrides, args.jobs), "checking")
+    else:
+        runs = [Checked.of(_check_one(d, f, args.tol, args.jobs, args.overrides))
+                for d, f in zip(designs, folders, strict=True)]
+    for run in runs if not args.json else []:
+        _show_check(run)
     if args.json:
-        _print_json([check_json(r) for r in runs], args.all)
-    if args.open:
-        for run in runs:
-            _open(run.folder / "report.html")
-    return 0 if all(r.passed for r in runs) else 1
+        _print_json([r.json for r in runs], args.all)
+    for run in runs if args.open else []:
+        _open(run.folder / "report.html")
+    return 0 if all(r.json["passed"] for r in runs) else 1
 
 
 def _build_task(_state: Any, design: Design, folder: Path, tol_mm: float | None,
@@ -406,13 +419,8 @@ def cmd_build(args) -> int:
     folders = _prepared_folders(args, designs)
     executor = make_executor(args.jobs)
     if executor.jobs > 1 and len(designs) > 1:
-        # the finest default mesh (the longest build, as a rule) last in line: the executor's own
-        # process takes the last task at once while the spawned workers start and take the others
-        order = sorted(range(len(designs)), key=lambda i: -float(designs[i].impl.mesh_tol_mm))
-        tasks = [(designs[i], folders[i], args.tol, args.overrides) for i in order]
-        with _display() as bars, bars("building", len(tasks), "template") as bar:
-            done = executor.map(_build_task, tasks, progress=bar.update)
-        built = [b for _, b in sorted(zip(order, done, strict=True), key=lambda x: x[0])]
+        built = _side_by_side(executor, designs, _build_task,
+                              lambda i: (designs[i], folders[i], args.tol, args.overrides), "building")
     else:
         built = []
         for d, f in zip(designs, folders, strict=True):
@@ -421,12 +429,10 @@ def cmd_build(args) -> int:
                 built.append(_build_task(None, d, f, args.tol, args.overrides, bars))
     if args.json:
         _print_json(built, args.all)
-    else:
-        for b, folder in zip(built, folders, strict=True):
-            _show(files_line(folder, [Path(b["folder"]) / f["file"] for f in b["files"]], len(b["parts"])))
-    if args.open:
-        for b in built:
-            _open(Path(b["folder"]))
+    for b, folder in zip(built, folders, strict=True) if not args.json else []:
+        _show(files_line(folder, [Path(b["folder"]) / f["file"] for f in b["files"]], len(b["parts"])))
+    for b in built if args.open else []:
+        _open(Path(b["folder"]))
     return 0
 
 

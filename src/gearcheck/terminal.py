@@ -454,3 +454,34 @@ class _Task:
         left = t.time_remaining
         self.progress.update(self.task, count=f"{t.completed:g}/{total} {self.unit}".rstrip(),
                              eta="" if left is None or t.finished else f"eta {clock(left)}")
+
+
+@dataclass
+class Checked:
+    """What the terminal shows of a finished check, as plain data (it comes back from a worker
+    process when ``check --all`` runs templates side by side)."""
+
+    result: CheckResult
+    name: str
+    folder: Path
+    files: list[Path]
+    parts: int
+    json: dict[str, Any]
+
+    @classmethod
+    def of(cls, run: CheckRun) -> Checked:
+        return cls(run.result, run.build.design.name, run.folder, list(run.files), len(run.build.parts),
+                   check_json(run))
+
+
+def check_task(_state: Any, design: Any, folder: Path, tol_mm: float | None, overrides: list[str],
+               jobs: int | None) -> Checked:
+    """One template's check for ``check --all`` (an executor task: templates run side by side).
+    A pool's worker process may not start processes of its own, so there the sweep runs in it
+    (``--jobs 1``); the calling process's template gets ``jobs``."""
+    import multiprocessing as mp
+
+    from gearcheck import pipeline
+
+    inner = 1 if mp.current_process().daemon else jobs
+    return Checked.of(pipeline.check(design, folder, tol_mm=tol_mm, jobs=inner, overrides=overrides))

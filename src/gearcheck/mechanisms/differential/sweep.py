@@ -10,15 +10,18 @@ placed them at (:func:`gearcheck.geometry.bevel_mesh.drive_poses`). Other shims 
 one translate the big gears along their own axes by the shim difference; nothing else about the
 geometry changes. A state at temperature T moves and shrinks (or grows) every gear by its own
 materials about its own datum (:mod:`.thermal`, from warm to T), never a uniform scale of the
-assembly. The extra states only at the template's shim: all shims × all states would triple the
-mesh work for figures the exact model gives anyway.
+assembly; the meshes as built serve every state, the world scaled by the small gear's factor
+(:func:`normalised_poses`). The extra states only at the template's shim: all shims × all states
+would triple the mesh work for figures the exact model gives anyway.
 
 Play of one output shaft: hold the small gears, turn the big gear about its own axis until a
-flank touches, both ways (bisection on ``collide``, :func:`gearcheck.sweep.engine.bisect_contact`,
-contact proven from both sides). The big gear meshes with *both* small gears, so each way it stops
-at the tighter of its two meshes: plus = min over the small gears, minus = max; play = plus −
-minus, in arcmin on the big gear's axis. That is the paper's "per side" backlash (one big/small
-mesh side of the shaft-to-shaft total, which is twice it).
+flank touches, both ways (the bisection on ``collide`` from a bracket around the exact contact,
+contact proven from both sides; found in few queries from a distance query's estimate or a
+congruent pair's contact, :func:`_bisect_mesh`, giving the plain bisection's bracket). The big
+gear meshes with *both* small gears, so each way it stops at the tighter of its two meshes: plus
+= min over the small gears, minus = max; play = plus − minus, in arcmin on the big gear's axis.
+That is the paper's "per side" backlash (one big/small mesh side of the shaft-to-shaft total,
+which is twice it).
 
 Cycle. Identical teeth: one small-gear tooth pitch of drive repeats every pose. With z_big odd
 (33) each big gear meets its two small gears half a tooth apart, so its play repeats every half
