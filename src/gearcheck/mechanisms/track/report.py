@@ -146,6 +146,8 @@ def notes(d: TrackSweep) -> list[str]:
     x, model, angles, wrap = d.x, d.model, d.angles, d.model.wrap
     deg = np.degrees
     n_poses = len(angles)
+    swept = n_poses + (d.worn_mesh.poses if d.worn_mesh is not None else 0)
+    worn = ", the new chain's and the worn chain's" if d.worn_mesh is not None else ""
     seated_counts = d.seated_counts
     min_plate, min_sleeve, off_plate = x["min_plate"], x["min_sleeve"], x["off_plate"]
     gap_proof, sleeve_proof, tol = d.gap_proof, d.sleeve_proof, d.contact_tol
@@ -174,9 +176,9 @@ def notes(d: TrackSweep) -> list[str]:
         f"Exact 2-D model (ISO 606 outline at {d.outline_step_mm} mm, no mesh): largest |mesh − exact| "
         f"over all {n_poses * wrap.links} link poses {d.max_dev:.4f} mm (bound {d.bound:.3f} mm).",
         *_wear_notes(d),
-        f"Speed: {n_poses} poses ({n_poses * wrap.links} link poses, each 2 FCL distances, and the FCL collision "
-        f"test where one is within {1000 * COLLIDE_SKIP_MM:g} µm: farther, the surfaces cannot meet) in "
-        f"{d.sweep_s:.2f} s = {n_poses / d.sweep_s:.0f} poses/s; the exact 2-D distances computed once, with the "
+        f"Speed: {swept} poses ({swept * wrap.links} link poses{worn}, each 2 FCL distances, and the FCL "
+        f"collision test where one is within {1000 * COLLIDE_SKIP_MM:g} µm: farther, the surfaces cannot meet) "
+        f"in {d.sweep_s:.2f} s = {swept / d.sweep_s:.0f} poses/s; the exact 2-D distances computed once, with the "
         f"smallest clearance before meshing; contact proofs {d.proof_s:.2f} s.",
     ]
 

@@ -389,9 +389,9 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
         WorstPose(f"track: min tip-to-plate distance, {data.where(min_plate)} (plate alone)", SPROCKET,
                   f"{names[min_plate.link]}.plate", s_pl.tolist(), pose_pl.tolist(), min_plate.value),
     ]
-    n_poses = len(angles)
-    timings = {"sweep_s": sweep_s, "poses_per_s": n_poses / sweep_s,
-               "link_poses_per_s": n_poses * wrap.links / sweep_s, "contact_proof_s": proof_s}
+    swept = len(results)  # sprocket poses swept: the new chain's and, where declared, the worn chain's
+    timings = {"sweep_s": sweep_s, "sprocket_poses": swept, "poses_per_s": swept / sweep_s,
+               "link_poses_per_s": swept * wrap.links / sweep_s, "contact_proof_s": proof_s}
     return SweepOutcome(summary(data), worst, timings, data)
 
 
