@@ -310,7 +310,7 @@ def side_figures(raw: dict[str, list], jobs_all: list[int], n_cores: int) -> dic
     fig["differential_contacts"] = diff.get("contacts")  # mesh contacts (one pair, one way); current code
     per_worker = diff.get("fcl_queries_per_s_per_worker", diff.get("collide_calls_per_s_per_worker"))
     queries, workers = fig["differential_fcl_queries"], diff.get("workers")
-    # the time spent on the meshes, per worker (what the calls/s figure is taken over)
+    # the time spent on the meshes, per worker (what the baseline's own calls/s figure is taken over)
     fig["differential_mesh_s_per_worker"] = (queries / per_worker / workers
                                              if queries and per_worker and workers else None)
     fig["steering_poses_per_s"] = sweeps["steering"][top]["per_s_over_wall"]
