@@ -105,11 +105,10 @@ class ToothFaces:
 
 
 def tooth_half_mask(vertices: np.ndarray, faces: np.ndarray, spec: BevelGearSpec, side: int,
-                    teeth: np.ndarray, located: ToothFaces | None = None) -> np.ndarray:
+                    teeth: np.ndarray) -> np.ndarray:
     """Faces (own frame) on the ``side`` half of the given teeth, above the root land: the side
     of a triangle is the sign of its centroid's azimuth from the nearest tooth centre. A tooth
     half carries its flank, its tip and its heel/toe edges, so every first contact of that
-    flank side (face or edge) lies in it. ``located``: the mesh's :class:`ToothFaces`, when
-    already found (one mesh, several masks)."""
-    located = ToothFaces.of(vertices, faces, spec) if located is None else located
-    return located.half_mask(side, teeth, spec)
+    flank side (face or edge) lies in it. For several masks of one mesh, locate its faces once
+    with :class:`ToothFaces`."""
+    return ToothFaces.of(vertices, faces, spec).half_mask(side, teeth, spec)

@@ -15,6 +15,7 @@ import subprocess
 import sys
 import tempfile
 import threading
+from typing import TypeVar
 
 
 class ChildProcess:
@@ -102,3 +103,22 @@ class ChildProcess:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+class ChildOwner:
+    """A user of one :class:`ChildProcess` (``self._child``), usable in a ``with`` block: leaving
+    it, or :meth:`close`, ends the process if still running and releases its pipes."""
+
+    _child: ChildProcess
+
+    def close(self) -> None:
+        self._child.close()
+
+    def __enter__(self: _Owner) -> _Owner:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+_Owner = TypeVar("_Owner", bound=ChildOwner)

@@ -36,6 +36,7 @@ from gearcheck.report.camera import (
     worst_direction,
     zoom_radius,
 )
+from gearcheck.report.child import ChildOwner
 from gearcheck.scene import PoseView, Scene, distance_text
 
 WIDTH, HEIGHT = 960, 720
@@ -94,7 +95,7 @@ def pictures(scene: Scene, timeout_s: float = TIMEOUT_S) -> dict[str, bytes]:
     return _received(done.returncode, done.stdout, done.stderr)
 
 
-class Drawing:
+class Drawing(ChildOwner):
     """The picture process of :func:`pictures`, started before its scene exists so that its
     start-up (Python, VTK) and the assembly picture overlap the run's other stages: started
     empty, given the scene as built (:meth:`assembly`: it draws the assembly picture at once),
@@ -134,15 +135,6 @@ class Drawing:
             raise PicturesUnavailable(f"VTK did not finish the pictures in {self.timeout_s:.0f} s")
         return _received(*done)
 
-    def close(self) -> None:
-        """End the process (if still running) and release its pipes."""
-        self._child.close()
-
-    def __enter__(self) -> Drawing:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
 
 render_pictures = pictures  # the name the pipeline calls it by

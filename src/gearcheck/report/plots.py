@@ -19,6 +19,7 @@ import math
 import re
 import textwrap
 
+from gearcheck.report.child import ChildOwner
 from gearcheck.results import Plot
 
 # Series colours (matplotlib's tab10, in order) and reference-line colours.
@@ -231,7 +232,7 @@ class PlotsUnavailable(RuntimeError):
     them itself."""
 
 
-class Plotting:
+class Plotting(ChildOwner):
     """The report's plots drawn by a process of their own (``python -m gearcheck.report.plots``,
     the plots pickled on its stdin, their HTML on its stdout), started with the run so that
     matplotlib loads while the CAD is built and the plots are drawn while the worst poses are
@@ -276,15 +277,6 @@ class Plotting:
         if not isinstance(out, list) or len(out) != self._count or not all(isinstance(p, str) for p in out):
             raise PlotsUnavailable("the plot process gave something other than the plots asked for")
         return out
-
-    def close(self) -> None:
-        self._child.close()
-
-    def __enter__(self) -> Plotting:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
 
 
 def _child() -> int:

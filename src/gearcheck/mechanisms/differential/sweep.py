@@ -127,9 +127,10 @@ def mesh_variant(thermal: Mapping[str, GearThermal], big: str, small: str, state
 
 
 def normalised_poses(thermal: Mapping[str, GearThermal], big: str, small: str, big_pose: np.ndarray,
-                     small_pose: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
-    """The pair in a thermal state as meshes *as built* (the big one scaled by the ratio r of the
-    two factors about its frame origin, r = 1 when both are steel): the two poses, and the ratio.
+                     small_pose: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The poses of the pair in a thermal state as meshes *as built* (the big one scaled by the
+    ratio r of the two factors about its frame origin, r = 1 when both are steel: see
+    :func:`mesh_variant`).
 
     A gear in a state is its mesh scaled by f about its frame origin, then posed
     (:meth:`.GearThermal.cold_pose_about_origin`): x = R·(f·p) + t = f·(R·p + t/f). Scaling the
@@ -141,7 +142,7 @@ def normalised_poses(thermal: Mapping[str, GearThermal], big: str, small: str, b
     pb, ps = tb.cold_pose_about_origin(big_pose), ts.cold_pose_about_origin(small_pose)
     pb[:3, 3] /= ts.scale
     ps[:3, 3] /= ts.scale
-    return pb, ps, tb.scale / ts.scale
+    return pb, ps
 
 
 def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: Mapping[str, dict[str, GearThermal]]
@@ -262,8 +263,7 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
         raise RuntimeError(f"{big_mesh} vs {small_mesh}: no contact bracket within 3× the mesh-error bound of the "
                            f"exact contact ({bp.arcmin(exact_rad):.4f}′): mesh and exact model disagree")
     return {"free_rad": bracket.free, "touching_rad": bracket.touching, "centred_collides": centred_collides,
-            "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened, "found_by": how,
-}
+            "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened, "found_by": how}
 
 
 def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float) -> dict:
@@ -414,7 +414,7 @@ def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list
                 for gb, gs, members in groups:
                     solve.append((placed[gb], placed[gs]))
                     pending.append(([(i, state, k, b, s) for b, s in members],
-                                    [(b, s, *normalised_poses(thermal, b, s, poses[b], poses[s])[:2],
+                                    [(b, s, *normalised_poses(thermal, b, s, poses[b], poses[s]),
                                       bound_mm[(b, s, state)] / d1_half, mesh_variant(thermal, b, s, state))
                                      for b, s in members]))
     t0 = time.perf_counter()
