@@ -154,3 +154,43 @@ def test_shared_meshes_decide_contact_as_the_scaled_ones(plan_and_run):
             break
     assert scaled_states >= 8
     assert math.isfinite(setup.bound_arcmin)
+
+
+def test_tasks_run_grouped_by_their_meshes_and_the_exact_range_last(plan_and_run):
+    from gearcheck.mechanisms.differential import sweep as ds
+
+    _, plan = plan_and_run
+    order = plan.order
+    assert sorted(order) == list(range(len(plan.tasks)))
+    kinds = [plan.tasks[i][0] for i in order]
+    n_mesh = kinds.count(ds.measure_contact)
+    assert all(k is ds.measure_contact for k in kinds[:n_mesh]) and all(
+        k is ds.exact_range_task for k in kinds[n_mesh:])
+    groups = [tuple(sorted(n for entry in plan.tasks[i][1][2] for n in entry[:2])) for i in order[:n_mesh]]
+    runs = [g for j, g in enumerate(groups) if j == 0 or g != groups[j - 1]]
+    assert len(runs) == len(set(groups)) >= 2  # each group's tasks side by side, once
+    # every pruned mesh is used by some task; a group uses a few of them
+    assert {n for g in groups for n in g} == {m.name for m in plan.meshes}
+    assert max(len(g) for g in groups) < len(plan.meshes)
+
+
+def test_worst_pose_distances_on_the_shared_whole_meshes_are_the_scaled_parts(plan_and_run):
+    """The reduce step measures the worst poses on the whole meshes as built (world scaled by the
+    small gear's factor); the same poses on the parts scaled as the report states them (each
+    part's mesh scaled about its frame origin, posed by the worst pose) give the same distance."""
+    from gearcheck.executor import SerialExecutor
+    from gearcheck.sweep.engine import Scene
+    from gearcheck.sweep.plan import make_scene, run_task
+
+    run, plan = plan_and_run
+    results = SerialExecutor().map(run_task, plan.tasks, setup=make_scene, shared=plan.meshes, first=plan.first)
+    outcome = plan.reduce(results)
+    assert len(outcome.worst_poses) == 2
+    for worst in outcome.worst_poses:
+        scene = Scene([run.bodies[worst.part_a].scaled(worst.scale_a).mesh,
+                       run.bodies[worst.part_b].scaled(worst.scale_b).mesh])
+        scene.set_pose(worst.part_a, np.asarray(worst.pose_a))
+        scene.set_pose(worst.part_b, np.asarray(worst.pose_b))
+        expected = scene.distance(worst.part_a, worst.part_b).distance
+        assert worst.mesh_distance_mm == pytest.approx(expected, rel=1e-9, abs=1e-12)
+    assert worst.scale_a != 1.0  # a cold state: the normalisation is exercised

@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from gearcheck.executor import ProcessExecutor, SerialExecutor, available_cores, make_executor
+from gearcheck.executor import ProcessExecutor, SerialExecutor, _Chunks, available_cores, make_executor
 from gearcheck.geometry.bisect import bisect
 from gearcheck.sweep.motion import ChainLink, Rotation, Translation
 
@@ -82,3 +82,49 @@ def _fails_at(_state: None, i: int) -> int:
 def test_a_failing_task_stops_the_map_wherever_it_ran():
     with pytest.raises(ArithmeticError, match="task 30"):
         ProcessExecutor(2).map(_fails_at, [(i,) for i in range(64)])
+
+
+def test_chunks_cover_every_task_once_and_shrink_towards_the_end():
+    for n, processes in ((1, 2), (7, 2), (200, 2), (1000, 4)):
+        queue = _Chunks(n, processes)
+        taken: list[int] = []
+        sizes = []
+        turn = 0
+        while queue:
+            if turn % 3 == 2:  # the calling process: one task at a time, from the back
+                taken.append(queue.take_last())
+            else:
+                start, end = queue.take_first()
+                sizes.append(end - start)
+                taken.extend(range(start, end))
+            turn += 1
+        assert sorted(taken) == list(range(n))
+        assert all(a >= b for a, b in zip(sizes, sizes[1:], strict=False))  # guided: never larger later
+        assert not sizes or (sizes[0] <= max(1, n // (8 * processes)) and sizes[-1] <= max(1, sizes[0]))
+        if n >= 200:
+            assert sizes[-1] <= 2 < sizes[0]
+
+
+def _marked(_state: None, i: int) -> tuple[int, bool]:
+    import os
+
+    return os.getpid(), bool(os.environ.get("GEARCHECK_TEST_FIRST"))
+
+
+def test_first_runs_once_in_the_calling_process_before_its_tasks(monkeypatch):
+    import os
+
+    monkeypatch.delenv("GEARCHECK_TEST_FIRST", raising=False)
+    calls: list[int] = []
+
+    def first() -> None:
+        calls.append(os.getpid())
+        os.environ["GEARCHECK_TEST_FIRST"] = "1"  # this process's own tasks see it, spawned ones do not
+
+    out = SerialExecutor().map(_marked, [(i,) for i in range(5)], first=first)
+    assert calls == [os.getpid()] and all(flag for _, flag in out)
+    monkeypatch.delenv("GEARCHECK_TEST_FIRST")
+    calls.clear()
+    out = ProcessExecutor(2).map(_marked, [(i,) for i in range(64)], first=first)
+    assert calls == [os.getpid()]
+    assert all(flag == (pid == os.getpid()) for pid, flag in out)

@@ -32,6 +32,18 @@ def test_distance_and_nearest_points():
     assert scene.collide("a", "b")
 
 
+def test_a_body_is_built_when_first_used():
+    scene = Scene([box("a", (2, 2, 2)), box("b", (2, 2, 2)), box("c", (1, 1, 1))])
+    assert scene.names == ["a", "b", "c"] and scene.built == []
+    scene.set_pose("b", translation(2.5))
+    assert scene.built == ["b"]
+    assert scene.distance("a", "b").distance == pytest.approx(0.5, abs=1e-9)
+    assert sorted(scene.built) == ["a", "b"]  # "c" never used: no BVH
+    scene.build()
+    assert sorted(scene.built) == ["a", "b", "c"]
+    assert not scene.collide("a", "c")  # c lies wholly inside a: surfaces, no intersection
+
+
 def test_bisection_finds_contact_from_both_sides():
     scene = Scene([box("a", (2, 2, 2)), box("b", (1, 1, 1))])
 

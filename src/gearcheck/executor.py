@@ -38,13 +38,15 @@ def available_cores() -> int:
 
 
 class Executor(Protocol):
-    """Runs ``fn(state, *args)`` for every ``args`` in ``tasks``; results in task order."""
+    """Runs ``fn(state, *args)`` for every ``args`` in ``tasks``; results in task order.
+    ``first``: work of the calling process's own (its result is not kept), done while the
+    workers start, before this process takes any task."""
 
     jobs: int
 
     def map(self, fn: Callable[..., Any], tasks: Sequence[tuple], *, setup: Callable[[Any], Any] | None = None,
             shared: Any = None, progress: Progress | None = None,
-            weights: Sequence[int] | None = None) -> list: ...
+            weights: Sequence[int] | None = None, first: Callable[[], Any] | None = None) -> list: ...
 
 
 def _advance(progress: Progress | None, weights: Sequence[int] | None, i: int) -> None:
@@ -57,7 +59,9 @@ class SerialExecutor:
 
     jobs = 1
 
-    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None) -> list:
+    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None, first=None) -> list:
+        if first is not None:
+            first()
         state = setup(shared) if setup is not None else shared
         out = []
         for i, args in enumerate(tasks):
@@ -147,23 +151,20 @@ class ProcessExecutor:
         if self.jobs < 1:
             raise ValueError(f"jobs must be at least 1, got {self.jobs}")
 
-    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None) -> list:
-        import collections
-
+    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None, first=None) -> list:
         tasks = list(tasks)
         workers = min(self.jobs, len(tasks))
         if workers <= 1:
-            return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights)
+            return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights,
+                                        first=first)
         log.debug("running %d tasks on %d processes (this one and %d spawned)", len(tasks), workers, workers - 1)
         ctx = mp.get_context("spawn")
-        size = max(1, len(tasks) // (8 * workers))
-        pending = collections.deque(range(0, len(tasks), size))  # chunk starts, in task order
+        queue = _Chunks(len(tasks), workers)
         out: list[Any] = [None] * len(tasks)
         with _Spawning() as spawning:
             pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared))
         with pool:  # leaving the block (an error, an interrupt) terminates the workers
             spawning.deliver()
-            state = setup(shared) if setup is not None else shared  # while the workers start
             inflight: dict[int, Any] = {}
 
             def finish(start: int, results: list) -> None:
@@ -172,21 +173,52 @@ class ProcessExecutor:
                     _advance(progress, weights, i)
 
             def feed() -> None:  # keep two chunks queued per spawned worker
-                while pending and len(inflight) < 2 * (workers - 1):
-                    start = pending.popleft()
-                    inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:start + size]))
+                while queue and len(inflight) < 2 * (workers - 1):
+                    start, end = queue.take_first()
+                    inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]))
 
-            while pending or inflight:
+            feed()
+            if first is not None:
+                first()  # while the workers start
+            state = setup(shared) if setup is not None else shared
+            while queue or inflight:
                 feed()
                 for start in [k for k, r in inflight.items() if r.ready()]:
                     finish(start, inflight.pop(start).get())
                 feed()
-                if pending:  # this process takes the last chunk in line, the workers the first
-                    start = pending.pop()
-                    finish(start, [fn(state, *args) for args in tasks[start:start + size]])
+                if queue:  # this process takes the last task in line, the workers the first chunks
+                    start = queue.take_last()
+                    finish(start, [fn(state, *tasks[start])])
                 elif inflight:
                     next(iter(inflight.values())).wait(0.05)
             return out
+
+
+class _Chunks:
+    """The tasks not yet taken, [lo, hi): the spawned workers take chunks from the front, this
+    process one task at a time from the back (so each keeps to its own run of tasks and the
+    meshes they use, and this process tops up the workers' queue after every task it runs).
+    Guided sizes: a chunk is at most 1/(8·processes) of all tasks (few round trips) and at most
+    1/(3·processes) of what is left, so chunks shrink towards the end and no process waits long
+    for another's last chunk."""
+
+    def __init__(self, n: int, processes: int):
+        self.lo, self.hi, self.processes = 0, n, processes
+        self.largest = max(1, n // (8 * processes))
+
+    def __bool__(self) -> bool:
+        return self.hi > self.lo
+
+    def take_first(self) -> tuple[int, int]:
+        """The next chunk from the front: (start, end)."""
+        size = max(1, min(self.largest, -(-(self.hi - self.lo) // (3 * self.processes))))
+        start, self.lo = self.lo, min(self.hi, self.lo + size)
+        return start, self.lo
+
+    def take_last(self) -> int:
+        """The last task."""
+        self.hi -= 1
+        return self.hi
 
 
 _dask_states: dict[str, Any] = {}
@@ -236,18 +268,22 @@ class DaskExecutor:
         if self._cluster is not None:
             self._cluster.close()
 
-    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None) -> list:
+    def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None, first=None) -> list:
         import uuid
 
         from distributed import as_completed
 
         tasks = list(tasks)
         if not tasks:
+            if first is not None:
+                first()
             return []
         token = uuid.uuid4().hex
         shared_ref = self.client.scatter(shared, broadcast=True) if shared is not None else None
         futures = [self.client.submit(_dask_task, fn, token, setup, shared_ref, tuple(a), pure=False,
                                       key=f"gearcheck-{token}-{i}") for i, a in enumerate(tasks)]
+        if first is not None:
+            first()  # while the cluster works
         index = {f.key: i for i, f in enumerate(futures)}
         for done in as_completed(futures):
             _advance(progress, weights, index[done.key])

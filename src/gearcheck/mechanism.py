@@ -97,7 +97,11 @@ class SweepPlan:
     """A sweep as data: the meshes every worker builds its scene from, the tasks (each a
     module-level function ``fn(scene, *args)`` and its picklable arguments: no CadQuery), the
     progress units of each task, and the reduce step that turns the task results (in task
-    order) into a :class:`~gearcheck.results.SweepOutcome` in this process."""
+    order) into a :class:`~gearcheck.results.SweepOutcome` in this process. ``order``, if given,
+    is the order to run the tasks in (a permutation of their indices; results still come back in
+    task order): tasks that use the same meshes next to each other, so that a worker taking a run
+    of them builds only those meshes' BVHs. ``first``, if given, is work of the calling process's
+    own, done while the workers start (e.g. the BVHs the reduce step will query)."""
 
     meshes: list[MeshData]
     tasks: list[Task]
@@ -105,6 +109,12 @@ class SweepPlan:
     weights: list[int] | None = None
     unit: str = "pose"
     options: dict = field(default_factory=dict)
+    order: list[int] | None = None
+    first: Callable[[], Any] | None = None
+
+    def __post_init__(self) -> None:
+        if self.order is not None and sorted(self.order) != list(range(len(self.tasks))):
+            raise ValueError("SweepPlan.order must be a permutation of the task indices")
 
     @property
     def total(self) -> int:

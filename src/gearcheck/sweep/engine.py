@@ -49,19 +49,38 @@ class Distance:
 
 
 class Scene:
-    """Named rigid bodies, each a BVH mesh, posed by 4×4 homogeneous matrices."""
+    """Named rigid bodies, each a BVH mesh, posed by 4×4 homogeneous matrices.
+
+    A body's BVH is built when the body is first posed or queried, not before: a worker that
+    runs only some of a plan's tasks builds only the meshes those tasks use (a plan orders its
+    tasks so that neighbours share meshes)."""
 
     def __init__(self, meshes: list[MeshData]):
+        self._meshes: dict[str, MeshData] = {mesh.name: mesh for mesh in meshes}
         self._objects: dict[str, fcl.CollisionObject] = {}
-        for mesh in meshes:
-            self._objects[mesh.name] = fcl.CollisionObject(_bvh(mesh), fcl.Transform())
 
     @property
     def names(self) -> list[str]:
+        return list(self._meshes)
+
+    @property
+    def built(self) -> list[str]:
+        """The bodies whose BVH exists so far."""
         return list(self._objects)
 
+    def build(self, names: list[str] | None = None) -> None:
+        """Build these bodies' BVHs now (default: every body's)."""
+        for name in self._meshes if names is None else names:
+            self._object(name)
+
+    def _object(self, name: str) -> fcl.CollisionObject:
+        obj = self._objects.get(name)
+        if obj is None:
+            obj = self._objects[name] = fcl.CollisionObject(_bvh(self._meshes[name]), fcl.Transform())
+        return obj
+
     def set_pose(self, name: str, pose: np.ndarray) -> None:
-        self._objects[name].setTransform(_transform(pose))
+        self._object(name).setTransform(_transform(pose))
 
     def set_poses(self, poses: dict[str, np.ndarray]) -> None:
         for name, pose in poses.items():
@@ -72,12 +91,12 @@ class Scene:
         another does not collide, so motion steps must stay small against the tooth size."""
         request = fcl.CollisionRequest(num_max_contacts=1, enable_contact=False)
         result = fcl.CollisionResult()
-        return fcl.collide(self._objects[a], self._objects[b], request, result) > 0
+        return fcl.collide(self._object(a), self._object(b), request, result) > 0
 
     def distance(self, a: str, b: str) -> Distance:
         request = fcl.DistanceRequest(enable_nearest_points=True, enable_signed_distance=False)
         result = fcl.DistanceResult()
-        d = fcl.distance(self._objects[a], self._objects[b], request, result)
+        d = fcl.distance(self._object(a), self._object(b), request, result)
         return Distance(max(float(d), 0.0), np.array(result.nearest_points[0]), np.array(result.nearest_points[1]))
 
 

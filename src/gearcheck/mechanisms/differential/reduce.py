@@ -18,12 +18,11 @@ from gearcheck.geometry.bevel_mesh import drive_poses
 from gearcheck.mechanisms.differential.analysis import PerSide, analyse_params, model_per_side
 from gearcheck.mechanisms.differential.params import shim_key
 from gearcheck.mechanisms.differential.poses import GearSpecs
-from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup
+from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup, normalised_poses, whole_name
 from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, merge_plays,
                                                            range_check)
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
 from gearcheck.results import SweepOutcome, WorstPose
-from gearcheck.sweep.engine import Scene
 
 # Mesh vs exact: within the mesh-error bound (as an angle on d1/2) plus this fraction.
 AGREEMENT_RELATIVE = 0.02
@@ -322,17 +321,20 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
     poses = drive_poses(built, layout.big_gears, layout.small_gears, layout.specs.big, layout.specs.small, phi,
                         shim - layout.template_shim_mm)
     tb, ts = thermal[big], thermal[small]
-    scene = Scene([bodies[big].scaled(tb.scale, tb.datum_local).mesh,
-                   bodies[small].scaled(ts.scale, ts.datum_local).mesh])
-    scene.set_pose(small, ts.cold_pose(poses[small]))
+    # the whole meshes as built, in the world scaled by 1 / (the small gear's factor)
+    scene = setup.whole
+    big_mesh, small_mesh = (whole_name(bodies, layout, big, tb.scale / ts.scale),
+                            whole_name(bodies, layout, small, 1.0))
     out = []
     way = "+" if d > 0 else "−"
     text = "cold" if state == "cold" else STATE_TEXT[state]
     for label, turn in ((f"{text} least play, contact {way} (free side), {math.degrees(phi):.2f}°", rec["free_rad"]),
                         (f"{text} least play, centred, {math.degrees(phi):.2f}°", 0.0)):
         big_pose = poses[big] @ bp.rot_z4(turn)
-        scene.set_pose(big, tb.cold_pose(big_pose))
-        distance = scene.distance(big, small).distance
+        pose_b, pose_s = normalised_poses(thermal, big, small, big_pose, poses[small])
+        scene.set_pose(big_mesh, pose_b)
+        scene.set_pose(small_mesh, pose_s)
+        distance = ts.scale * scene.distance(big_mesh, small_mesh).distance
         out.append(WorstPose(label, big, small, tb.cold_pose_about_origin(big_pose).tolist(),
                              ts.cold_pose_about_origin(poses[small]).tolist(), float(distance), tb.scale, ts.scale))
     return out

@@ -179,6 +179,34 @@ def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: 
     return out
 
 
+def whole_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: Mapping[str, dict[str, GearThermal]]
+                 ) -> Scene:
+    """The gears' whole (unpruned) meshes as built, one per distinct mesh (the two big gears share
+    one, the two small gears another), and for a state whose gears scale differently the big
+    gear's scaled by the ratio of the factors (see :func:`normalised_poses`): the reduce step's
+    worst-pose distances, in a scene of their own (its BVHs built by the calling process while
+    the workers start). Named by :func:`whole_name`."""
+    meshes: dict[str, MeshData] = {}
+    for big in layout.big_gears:
+        for small in layout.small_gears:
+            for th in thermal_by_state.values():
+                for gear, ratio in ((big, th[big].scale / th[small].scale), (small, 1.0)):
+                    name = whole_name(bodies, layout, gear, ratio)
+                    if name not in meshes:
+                        body = bodies[gear] if ratio == 1.0 else bodies[gear].scaled(ratio)
+                        meshes[name] = MeshData(name, body.mesh.vertices, body.mesh.faces)
+    return Scene(list(meshes.values()))
+
+
+def whole_name(bodies: Mapping[str, Body], layout: Layout, gear: str, ratio: float) -> str:
+    """The whole mesh of ``gear`` scaled by ``ratio``: the first gear of the layout with the same
+    mesh arrays (identical parts share them) names it."""
+    mesh = bodies[gear].mesh
+    same = next(g for g in layout.big_gears + layout.small_gears
+                if bodies[g].mesh.vertices is mesh.vertices and bodies[g].mesh.faces is mesh.faces)
+    return f"whole|{same}|{ratio!r}"
+
+
 # --------------------------------------------------------------------------------------------
 # One measurement (a worker task: numpy + fcl only)
 
@@ -271,6 +299,7 @@ def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list
     planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
     the pair itself and its congruent twins (each twin expects the contact where the pair before
     it had it, and proves its own)."""
+    scene.build([name for entry in meshes for name in entry[:2]])  # BVHs first: not part of a measurement's time
     mesh = []
     hint = None
     for bm, sm, bpose, spose, bound in meshes:
@@ -313,6 +342,7 @@ class SweepSetup:
     bound_arcmin: float  # that bound as an angle on d1/2
     pruned_meshes: int
     pruned_triangles_mean: float
+    whole: Scene  # the whole meshes for the worst-pose distances (:func:`whole_meshes`)
     started: float  # perf_counter when the plan was made (wall time of the sweep)
 
 
@@ -333,7 +363,7 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
     """Sweep each shim's states over one cycle of the output shafts' play; one mesh task per
     distinct exact contact (and direction), with the mesh bisections of every pair congruent to
     it; and the exact range tasks."""
-    from gearcheck.mechanisms.differential.reduce import reduce_sweep
+    from gearcheck.mechanisms.differential.reduce import FAIL_STATES, reduce_sweep
 
     options = dict(options or {})
     unknown = sorted(set(options) - set(OPTIONS))
@@ -384,10 +414,25 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         shims=shims, angles=angles, period_rad=period, owners=owners, range_tasks=range_tasks,
         exact_solves=len(pending) * len(DIRECTIONS), exact_reused=reused, exact_s=exact_s, bound_mm=bound_max_mm,
         bound_arcmin=bound_max_mm / d1_half * bp.ARCMIN_PER_RAD, pruned_meshes=len(meshes),
-        pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started)
+        pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started,
+        whole=whole_meshes(bodies, layout, {n: th for n, th in scales.items() if n in FAIL_STATES}))
     return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
-                     weights=weights, unit="contact",
+                     weights=weights, unit="contact", order=run_order(tasks, range_tasks), first=setup.whole.build,
                      options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
+
+
+def run_order(tasks: list[tuple], range_tasks: list[tuple[int, int]]) -> list[int]:
+    """The order to run the tasks in: mesh tasks grouped by the meshes they use (a worker taking a
+    run of them builds a few of the plan's BVHs, not all), in plan order within a group, then the
+    exact range tasks (no mesh; the calling process, which takes tasks from the back, starts on
+    them while the spawned workers start)."""
+    ranged = {task for _, task in range_tasks}
+
+    def meshes_of(n: int) -> tuple[str, ...]:
+        return tuple(sorted(name for entry in tasks[n][1][2] for name in entry[:2]))
+
+    mesh_tasks = sorted((n for n in range(len(tasks)) if n not in ranged), key=meshes_of)
+    return mesh_tasks + sorted(ranged)
 
 
 def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list[float], shim_states: list[list[int]],
