@@ -191,6 +191,10 @@ def test_worst_pose_distances_on_the_shared_whole_meshes_are_the_scaled_parts(pl
                        run.bodies[worst.part_b].scaled(worst.scale_b).mesh])
         scene.set_pose(worst.part_a, np.asarray(worst.pose_a))
         scene.set_pose(worst.part_b, np.asarray(worst.pose_b))
-        expected = scene.distance(worst.part_a, worst.part_b).distance
-        assert worst.mesh_distance_mm == pytest.approx(expected, rel=1e-9, abs=1e-12)
+        expected = scene.distance(worst.part_a, worst.part_b)
+        assert worst.mesh_distance_mm == pytest.approx(expected.distance, rel=1e-9, abs=1e-12)
+        # what the confirmation would otherwise ask the meshes itself
+        assert worst.mesh_overlap is scene.collide(worst.part_a, worst.part_b)
+        midpoint = 0.5 * (expected.point_a + expected.point_b)
+        assert np.allclose(worst.mesh_nearest_midpoint, midpoint, rtol=0.0, atol=1e-9)
     assert worst.scale_a != 1.0  # a cold state: the normalisation is exercised

@@ -315,14 +315,22 @@ class _MeshPairs:
         return scene
 
     def overlap(self, worst: Any) -> bool:
-        """Whether the two meshes intersect at the worst pose (whole parts)."""
+        """Whether the two meshes intersect at the worst pose (whole parts; the sweep's answer
+        where it gave one)."""
+        if worst.mesh_overlap is not None:
+            return bool(worst.mesh_overlap)
         a, b = (n.partition(".")[0] for n in (worst.part_a, worst.part_b))
         return bool(self._posed(a, b, worst).collide(a, b))
 
     def nearest_midpoint(self, worst: Any) -> Any:
-        """Where the meshes come closest (world frame); None for a feature of a part."""
+        """Where the meshes come closest (world frame; the sweep's answer where it gave one);
+        None for a feature of a part."""
+        import numpy as np
+
         if "." in worst.part_a or "." in worst.part_b:
             return None
+        if worst.mesh_nearest_midpoint is not None:
+            return np.asarray(worst.mesh_nearest_midpoint, float)
         d = self._posed(worst.part_a, worst.part_b, worst).distance(worst.part_a, worst.part_b)
         return 0.5 * (d.point_a + d.point_b)
 

@@ -126,6 +126,11 @@ class WorstPose:
     scale_a: float = 1.0
     scale_b: float = 1.0
     key: str = ""  # JSON key in summary.json; default: made from the label
+    # what the sweep's own whole meshes said at the pose, when it measured there (None: the
+    # confirmation asks the meshes itself): whether they intersect, and the midpoint of their
+    # nearest points (world, mm)
+    mesh_overlap: bool | None = None
+    mesh_nearest_midpoint: tuple[float, float, float] | None = None
 
     @property
     def json_key(self) -> str:

@@ -334,9 +334,12 @@ def _worst_poses(setup: SweepSetup, data: SweepData, by_key: dict) -> list[Worst
         pose_b, pose_s = normalised_poses(thermal, big, small, big_pose, poses[small])
         scene.set_pose(big_mesh, pose_b)
         scene.set_pose(small_mesh, pose_s)
-        distance = ts.scale * scene.distance(big_mesh, small_mesh).distance
+        near = scene.distance(big_mesh, small_mesh)
+        midpoint = ts.scale * 0.5 * (near.point_a + near.point_b)
         out.append(WorstPose(label, big, small, tb.cold_pose_about_origin(big_pose).tolist(),
-                             ts.cold_pose_about_origin(poses[small]).tolist(), float(distance), tb.scale, ts.scale))
+                             ts.cold_pose_about_origin(poses[small]).tolist(), float(ts.scale * near.distance),
+                             tb.scale, ts.scale, mesh_overlap=scene.collide(big_mesh, small_mesh),
+                             mesh_nearest_midpoint=(float(midpoint[0]), float(midpoint[1]), float(midpoint[2]))))
     return out
 
 

@@ -153,8 +153,11 @@ def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: 
     specs = layout.specs
     big_spec, small_spec = specs.big, specs.small
     out = []
-    located = {n: ToothFaces.of(bodies[n].mesh.vertices, bodies[n].mesh.faces, big_spec if n in layout.big_gears
-                                else small_spec) for n in layout.big_gears + layout.small_gears}
+    located: dict[str, ToothFaces] = {}
+    for n in layout.big_gears + layout.small_gears:  # identical parts share their mesh: located once
+        shared = whole_name(bodies, layout, n, 1.0).split("|")[1]
+        located[n] = located.get(shared) or ToothFaces.of(bodies[n].mesh.vertices, bodies[n].mesh.faces,
+                                                           big_spec if n in layout.big_gears else small_spec)
     for big in layout.big_gears:
         for small in layout.small_gears:
             b, s = bodies[big], bodies[small]
