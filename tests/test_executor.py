@@ -128,3 +128,39 @@ def test_first_runs_once_in_the_calling_process_before_its_tasks(monkeypatch):
     out = ProcessExecutor(2).map(_marked, [(i,) for i in range(64)], first=first)
     assert calls == [os.getpid()]
     assert all(flag == (pid == os.getpid()) for pid, flag in out)
+
+
+def _index_task(scene, i: int) -> tuple[int, list[str]]:
+    return i, scene.built
+
+
+def test_a_plan_runs_in_its_order_and_its_results_come_back_in_task_order():
+    from gearcheck.mechanism import SweepPlan
+    from gearcheck.sweep.bodies import MeshData
+    from gearcheck.sweep.plan import run_plan
+
+    tri = MeshData("t", np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    tasks = [(_index_task, (i,)) for i in range(40)]
+    done: list[str] = []
+    order = list(range(39, -1, -1))
+    plan = SweepPlan([tri], tasks, reduce=lambda r: r, weights=[2] * 40, order=order,
+                     first=lambda: done.append("first"))
+    ticks: list[int] = []
+    for executor in (SerialExecutor(), ProcessExecutor(2)):
+        done.clear()
+        out = run_plan(executor, plan, ticks.append)
+        assert [i for i, _ in out] == list(range(40)) and done == ["first"]
+        assert all(built == [] for _, built in out)  # no task used the mesh: no BVH built
+    assert sum(ticks) == 2 * 2 * 40
+
+    class Older:  # an executor from before ``first``: the plan's first work is done before its map
+        jobs = 1
+
+        def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None):
+            assert done == ["first"]
+            return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights)
+
+    done.clear()
+    assert [i for i, _ in run_plan(Older(), plan)] == list(range(40))
+    with pytest.raises(ValueError, match="permutation"):
+        SweepPlan([tri], tasks, reduce=lambda r: r, order=[0] * 40)

@@ -242,7 +242,7 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     comes after."""
     from gearcheck import resolution
     from gearcheck.executor import make_executor
-    from gearcheck.sweep.plan import make_scene, run_task
+    from gearcheck.sweep.plan import run_plan
 
     impl = design.impl
     check_poses(assembly, bodies)
@@ -253,14 +253,8 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     plan = impl.plan(design.params, assembly, bodies, options)
     log.info("stage sweep: %s, %d tasks on %d worker(s)", design.name, len(plan.tasks), executor.jobs)
     t0 = time.perf_counter()
-    order = plan.order if plan.order is not None else list(range(len(plan.tasks)))
-    weights = [plan.weights[i] for i in order] if plan.weights is not None else None
     with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar:
-        ran = executor.map(run_task, [plan.tasks[i] for i in order], setup=make_scene, shared=plan.meshes,
-                           progress=bar.update, weights=weights, first=plan.first)
-    results: list[Any] = [None] * len(order)
-    for i, result in zip(order, ran, strict=True):
-        results[i] = result
+        results = run_plan(executor, plan, bar.update)
     log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs,
              time.perf_counter() - t0)
     outcome = plan.reduce(results)
