@@ -91,6 +91,7 @@ def test_chunks_cover_every_task_once_and_shrink_towards_the_end():
         sizes = []
         turn = 0
         while queue:
+            assert len(queue) == n - len(taken)
             if turn % 3 == 2:  # the calling process: one task at a time, from the back
                 taken.append(queue.take_last())
             else:

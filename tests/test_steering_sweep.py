@@ -289,8 +289,7 @@ def test_estimated_contacts_are_the_plain_bisections(build_bodies, monkeypatch):
     plan = steering_sweep.plan(run.design.params, run.assembly, run.bodies)
     power = [t for t in plan.tasks if t[0] is tasks.power_task]
     coarse = steering_sweep.plan(run.design.params, run.assembly, run.bodies, {"towing_step_deg": 1.0})
-    (_, (kin, directions, *towing_args)), = [t for t in coarse.tasks if t[0] is tasks.towing_tasks]
-    picked = power + [(tasks.towing_task, (kin, d, *towing_args)) for d in directions]
+    picked = power + [t for t in coarse.tasks if t[0] is tasks.towing_task]
     assert len(power) == 2 and len(picked) == 4
     faces = {m.name: len(m.faces) for m in plan.meshes}
     for flanks, rest in tasks.REST_OF.items():  # the flanks and the rest split the swept rack's triangles

@@ -172,8 +172,8 @@ class ProcessExecutor:
                     out[i] = result
                     _advance(progress, weights, i)
 
-            def feed() -> None:  # keep two chunks queued per spawned worker
-                while queue and len(inflight) < 2 * (workers - 1):
+            def feed() -> None:  # two chunks in flight per spawned worker; one when few tasks are left
+                while queue and len(inflight) < (2 if len(queue) > workers else 1) * (workers - 1):
                     start, end = queue.take_first()
                     inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]))
 
@@ -200,7 +200,8 @@ class _Chunks:
     meshes they use, and this process tops up the workers' queue after every task it runs).
     Guided sizes: a chunk is at most 1/(8·processes) of all tasks (few round trips) and at most
     1/(3·processes) of what is left, so chunks shrink towards the end and no process waits long
-    for another's last chunk."""
+    for another's last chunk; and with no more tasks left than processes, a worker gets one only
+    when it has none in flight (the last few go to whoever is free, this process included)."""
 
     def __init__(self, n: int, processes: int):
         self.lo, self.hi, self.processes = 0, n, processes
@@ -208,6 +209,9 @@ class _Chunks:
 
     def __bool__(self) -> bool:
         return self.hi > self.lo
+
+    def __len__(self) -> int:
+        return self.hi - self.lo
 
     def take_first(self) -> tuple[int, int]:
         """The next chunk from the front: (start, end)."""

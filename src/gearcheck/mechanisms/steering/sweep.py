@@ -126,7 +126,7 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
         Kinematics,
         power_task,
         rest_meshes,
-        towing_tasks,
+        towing_task,
     )
 
     t_start = time.perf_counter()
@@ -178,19 +178,19 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     reach_angle_per_mm = REACH_MARGIN / (centre_height - rack_top)
 
     mirror = np.array([-1.0, 1.0])
-    # Power mode one task per direction, towing both directions in one: an executor that works in
-    # this process too sends the first tasks to its workers and takes the last itself while they
-    # start, so the longer towing swings go to the process that starts at once, and no worker that
-    # finished early takes the second swing from it (only the wall time changes; reduce puts the
-    # results in the order towing +, towing −, power +, power −).
-    tasks: list[Task] = [(power_task, (kin, d, travels, tol, reach_angle_per_mm, limit, profile, corner * m,
-                                       normal * m, up * m, g.pitch))
-                         for d, m in ((+1, np.ones(2)), (-1, mirror))]
-    tasks.append((towing_tasks, (kin, (+1, -1), angles, tol, reach_travel_per_rad, limit)))
-    weights = [len(travels)] * 2 + [4 * len(angles)]  # poses per task
+    # One task per mode and direction (the swings of one towing direction follow each other: one
+    # task), in the order towing +, power +, power −, towing −: two processes end up with one towing
+    # and one power task each (the spawned worker is sent the first two, this process takes the
+    # last ones in line), the work split about evenly; reduce gets them in the order towing +,
+    # towing −, power +, power −.
+    power = [(power_task, (kin, d, travels, tol, reach_angle_per_mm, limit, profile, corner * m, normal * m, up * m,
+                           g.pitch)) for d, m in ((+1, np.ones(2)), (-1, mirror))]
+    towing = [(towing_task, (kin, d, angles, tol, reach_travel_per_rad, limit)) for d in (+1, -1)]
+    tasks: list[Task] = [towing[0], *power, towing[1]]
+    weights = [2 * len(angles), len(travels), len(travels), 2 * len(angles)]  # poses per task
 
     def reduce(sent: list) -> SweepOutcome:
-        results = [*sent[2], sent[0], sent[1]]
+        results = [sent[0], sent[3], sent[1], sent[2]]
         drives = _mesh_drives(g, kin, flank_pairs, results)
         return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives)
 

@@ -356,12 +356,6 @@ def towing_task(scene: Scene, kin: Kinematics, direction: int, angles: np.ndarra
     }
 
 
-def towing_tasks(scene: Scene, kin: Kinematics, directions: tuple[int, ...], angles: np.ndarray, tol: float,
-                 reach_rate: float, limit: float) -> list[dict]:
-    """:func:`towing_task` in each direction in turn, as one task (run by one process)."""
-    return [towing_task(scene, kin, d, angles, tol, reach_rate, limit) for d in directions]
-
-
 def power_task(scene: Scene, kin: Kinematics, direction: int, travels: np.ndarray, tol: float, reach_rate: float,
                limit: float, profile: np.ndarray, corner: np.ndarray, normal: np.ndarray, up: np.ndarray,
                pitch: float) -> dict:
