@@ -139,12 +139,12 @@ def _run_chunk(fn: Callable[..., Any], chunk: list[tuple]) -> list:
 
 class ProcessExecutor:
     """``jobs`` processes (default: every core this process may use): this one and ``jobs − 1``
-    spawned workers, all taking chunks of tasks from one queue.
+    spawned workers, all taking tasks from one queue (:class:`_Chunks`).
 
-    This process works too: it would only wait otherwise, and it makes its state (a sweep's BVHs)
-    while the workers start, so two processes do close to twice the work of one — the spawned
-    workers' start-up (interpreter, imports, their own state) is the only cost that does not
-    shrink with more processes, and this process hides its share of it."""
+    This process works too: it would only wait otherwise, and it does its ``first`` work and its
+    first tasks while the workers start, so two processes do close to twice the work of one — the
+    spawned workers' start-up (interpreter, imports, their own state) is the only cost that does
+    not shrink with more processes, and this process hides its share of it."""
 
     def __init__(self, jobs: int | None = None):
         self.jobs = available_cores() if jobs is None else int(jobs)

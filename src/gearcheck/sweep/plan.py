@@ -13,7 +13,7 @@ from gearcheck.sweep.engine import Scene
 
 
 def make_scene(meshes: list[MeshData]) -> Scene:
-    """A worker's scene: one BVH per mesh, built once."""
+    """A worker's scene: one BVH per mesh, built once, when a task first uses it."""
     return Scene(meshes)
 
 
