@@ -215,7 +215,7 @@ class _Chunks:
 
     def take_first(self) -> tuple[int, int]:
         """The next chunk from the front: (start, end)."""
-        size = max(1, min(self.largest, -(-(self.hi - self.lo) // (3 * self.processes))))
+        size = max(1, min(self.largest, -(-len(self) // (3 * self.processes))))
         start, self.lo = self.lo, min(self.hi, self.lo + size)
         return start, self.lo
 

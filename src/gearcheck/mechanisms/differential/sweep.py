@@ -155,9 +155,11 @@ def pruned_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: 
     out = []
     located: dict[str, ToothFaces] = {}
     for n in layout.big_gears + layout.small_gears:  # identical parts share their mesh: located once
-        shared = whole_name(bodies, layout, n, 1.0).split("|")[1]
-        located[n] = located.get(shared) or ToothFaces.of(bodies[n].mesh.vertices, bodies[n].mesh.faces,
-                                                           big_spec if n in layout.big_gears else small_spec)
+        shared = _mesh_owner(bodies, layout, n)
+        if shared not in located:
+            located[shared] = ToothFaces.of(bodies[n].mesh.vertices, bodies[n].mesh.faces,
+                                            big_spec if n in layout.big_gears else small_spec)
+        located[n] = located[shared]
     for big in layout.big_gears:
         for small in layout.small_gears:
             b, s = bodies[big], bodies[small]
@@ -201,13 +203,17 @@ def whole_meshes(bodies: Mapping[str, Body], layout: Layout, thermal_by_state: M
     return Scene(list(meshes.values()))
 
 
-def whole_name(bodies: Mapping[str, Body], layout: Layout, gear: str, ratio: float) -> str:
-    """The whole mesh of ``gear`` scaled by ``ratio``: the first gear of the layout with the same
-    mesh arrays (identical parts share them) names it."""
+def _mesh_owner(bodies: Mapping[str, Body], layout: Layout, gear: str) -> str:
+    """The first gear of the layout whose mesh is ``gear``'s (identical parts share the arrays)."""
     mesh = bodies[gear].mesh
-    same = next(g for g in layout.big_gears + layout.small_gears
+    return next(g for g in layout.big_gears + layout.small_gears
                 if bodies[g].mesh.vertices is mesh.vertices and bodies[g].mesh.faces is mesh.faces)
-    return f"whole|{same}|{ratio!r}"
+
+
+def whole_name(bodies: Mapping[str, Body], layout: Layout, gear: str, ratio: float) -> str:
+    """The whole mesh of ``gear`` scaled by ``ratio``, named by the gear that owns the mesh
+    (:func:`_mesh_owner`)."""
+    return f"whole|{_mesh_owner(bodies, layout, gear)}|{ratio!r}"
 
 
 # --------------------------------------------------------------------------------------------
@@ -297,12 +303,17 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
             "calls": counted.queries, "mesh_s": time.perf_counter() - t0, "widened": widened, "found_by": how}
 
 
+def _mesh_names(meshes: list[tuple]) -> list[str]:
+    """The mesh names a contact task uses (its pairs' big and small meshes)."""
+    return [name for entry in meshes for name in entry[:2]]
+
+
 def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float) -> dict:
     """The mesh contact of each listed pair posed congruently to one exact contact (solved in the
     planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
     the pair itself and its congruent twins (each twin expects the contact where the pair before
     it had it, and proves its own)."""
-    scene.build([name for entry in meshes for name in entry[:2]])  # BVHs first: not part of a measurement's time
+    scene.build(_mesh_names(meshes))  # BVHs first: not part of a measurement's time
     mesh = []
     hint = None
     for bm, sm, bpose, spose, bound in meshes:
@@ -432,7 +443,7 @@ def run_order(tasks: list[tuple], range_tasks: list[tuple[int, int]]) -> list[in
     ranged = {task for _, task in range_tasks}
 
     def meshes_of(n: int) -> tuple[str, ...]:
-        return tuple(sorted(name for entry in tasks[n][1][2] for name in entry[:2]))
+        return tuple(sorted(_mesh_names(tasks[n][1][2])))
 
     mesh_tasks = sorted((n for n in range(len(tasks)) if n not in ranged), key=meshes_of)
     return mesh_tasks + sorted(ranged)
