@@ -45,6 +45,63 @@ def test_replayed_halving_is_the_plain_bisection():
             assert (wrong[0].free, wrong[0].touching) == (plain.free, plain.touching)
 
 
+def test_answers_carried_between_tries_are_used_and_change_nothing():
+    """A wider try after a missed narrow one, sharing the answers: the plain bisection's bracket,
+    no turn asked twice, and fewer calls than the wide try alone."""
+    rng = random.Random(11)
+    saved = 0
+    for _ in range(300):
+        lo, hi = sorted(rng.uniform(-5.0, 5.0) for _ in range(2))
+        threshold = rng.uniform(lo, hi)
+        tol = (hi - lo) * 10 ** rng.uniform(-6, -3)
+        flip = rng.random() < 0.5
+        free, touching = (hi, lo) if flip else (lo, hi)
+        calls: list[float] = []
+
+        def flag(x: float, t=threshold, f=flip, c=calls) -> bool:
+            c.append(x)
+            return x <= t if f else x >= t
+
+        plain = bisect(flag, free, touching, tol, check_ends=False)
+        sign = 1.0 if touching > free else -1.0
+        estimate = threshold + sign * rng.uniform(2.0, 80.0) * tol  # an overshoot, as the meshes' misses are
+        calls.clear()
+        asked: dict[float, bool] = {}
+        assert bisect_predicted(flag, free, touching, tol, estimate, 0.5 * tol, asked=asked) is None
+        found = bisect_predicted(flag, free, touching, tol, estimate, 160 * tol, asked=asked)
+        assert found is not None
+        assert (found[0].free, found[0].touching) == (plain.free, plain.touching)
+        assert len(calls) == len(set(calls))  # nothing asked twice
+        calls.clear()
+        alone = bisect_predicted(flag, free, touching, tol, estimate, 160 * tol)
+        assert alone is not None and (alone[0].free, alone[0].touching) == (plain.free, plain.touching)
+        assert found[1] <= alone[1] == len(calls)  # the wide try's calls, with the answers shared and alone
+        saved += alone[1] - found[1]
+        # answers that contradict one change decide nothing: the bracket is still proven
+        odd = {free + 0.5 * (touching - free): True, free + 0.25 * (touching - free): False,
+               free + 0.2 * (touching - free): True}
+        mixed = bisect_predicted(flag, free, touching, tol, threshold, tol, asked=dict(odd))
+        if mixed is not None:
+            assert not flag(mixed[0].free) and flag(mixed[0].touching) and mixed[0].width <= tol
+    assert saved > 0
+
+
+def test_earlier_answers_decide_midpoints_beyond_them_whatever_the_estimate():
+    # the plain bracket's two ends already answered: every midpoint is decided by them (one change
+    # over the bracket), so even an estimate far off finds that bracket with no new call
+    threshold, tol = 0.3141, 1e-6
+
+    def flag(x: float) -> bool:
+        return x >= threshold
+
+    plain = bisect(flag, -1.0, 2.0, tol, check_ends=False)
+    asked = {plain.free: False, plain.touching: True}
+    found = bisect_predicted(flag, -1.0, 2.0, tol, 1.7, 0.0, asked=asked)
+    assert found is not None and (found[0].free, found[0].touching) == (plain.free, plain.touching)
+    assert found[1] == 0
+    assert bisect_predicted(flag, -1.0, 2.0, tol, 1.7, 0.0) is None  # the same estimate alone misses
+
+
 def test_a_proven_bracket_holds_even_when_the_flag_is_not_monotone():
     # two contacts: flag true on [1, 2] and beyond 3; an estimate near 3 proves a real change there
     def flag(x: float) -> bool:

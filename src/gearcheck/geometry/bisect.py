@@ -7,6 +7,7 @@ wider than ``tol`` (or for ``max_iter`` halvings), keeping one end on each side.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -55,7 +56,8 @@ def bisect(flag: Callable[[float], bool], free: float, touching: float, tol: flo
 
 
 def bisect_predicted(flag: Callable[[float], bool], free: float, touching: float, tol: float, estimate: float,
-                     margin: float, max_iter: int = DEFAULT_MAX_ITER) -> tuple[Bracket, int] | None:
+                     margin: float, max_iter: int = DEFAULT_MAX_ITER,
+                     asked: dict[float, bool] | None = None) -> tuple[Bracket, int] | None:
     """The bracket :func:`bisect` (``check_ends=False``) would end with, found with few calls of
     ``flag`` when the change is expected at ``estimate`` (within ``margin``).
 
@@ -65,23 +67,42 @@ def bisect_predicted(flag: Callable[[float], bool], free: float, touching: float
     once over the bracket (a monotone contact), a proven final bracket means every midpoint that
     was not asked lies on the side the estimate gave it, so the result is the plain bisection's,
     bit for bit. Returns the bracket and the number of calls, or None when the final bracket does
-    not hold (the estimate was wrong): the caller then bisects as usual."""
+    not hold (the estimate was wrong): the caller then tries a wider margin or bisects as usual.
+
+    ``asked`` (turn → flag) carries the answers of earlier tries on the same bracket: none is asked
+    twice, and a midpoint not beyond the farthest free answer (or not short of the nearest
+    touching one) takes that side, as one change over the bracket implies, wherever the estimate
+    puts it. Answers that contradict one change decide nothing."""
     sign = 1.0 if touching > free else -1.0
     calls = 0
-    asked: dict[float, bool] = {}
+    asked = {} if asked is None else asked
+    lo, hi = sorted((free, touching))
+    inside = [(sign * x, hit) for x, hit in asked.items() if lo <= x <= hi]
+    last_free = max((s for s, hit in inside if not hit), default=-math.inf)
+    first_touching = min((s for s, hit in inside if hit), default=math.inf)
 
     def ask(x: float) -> bool:
-        nonlocal calls
+        nonlocal calls, last_free, first_touching
         if x not in asked:
             calls += 1
             asked[x] = flag(x)
+            if asked[x]:
+                first_touching = min(first_touching, sign * x)
+            else:
+                last_free = max(last_free, sign * x)
         return asked[x]
 
     for _ in range(max_iter):
         if abs(touching - free) <= tol:
             break
         mid = 0.5 * (free + touching)
-        hit = ask(mid) if abs(mid - estimate) <= margin else sign * (mid - estimate) > 0.0
+        s = sign * mid
+        if last_free < first_touching and (s <= last_free or s >= first_touching):
+            hit = s >= first_touching  # an answer beyond it decides, given one change
+        elif abs(mid - estimate) <= margin:
+            hit = ask(mid)
+        else:
+            hit = sign * (mid - estimate) > 0.0
         if hit:
             touching = mid
         else:

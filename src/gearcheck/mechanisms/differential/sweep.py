@@ -99,7 +99,7 @@ BRACKET_OUTSIDE_ARCMIN = 0.3
 # asked of the meshes; farther ones are given the side the estimate puts them on, then the final
 # bracket is proven from both sides. The estimate is good to about one tolerance where the nearest
 # mesh features stay the same up to contact, to about a hundred where they change: a narrow
-# margin first, then a wide one, then the plain bisection.
+# margin first, then a wide one (with the narrow try's answers), then the plain bisection.
 NEWTON_MARGINS_TOL = (0.5, 160.0)
 # Pruning: extra teeth kept beyond the exact model's window and the cycle's turn.
 PRUNE_EXTRA_TEETH = 1
@@ -256,9 +256,13 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
     counted = CountedScene(scene)
     counted.set_pose(small_mesh, small_pose)
 
+    asked: dict[float, bool] = {}  # every answer, shared by the tries below
+
     def collides(turn: float) -> bool:
-        counted.set_pose(big_mesh, big_pose @ bp.rot_z4(turn))
-        return counted.collide(big_mesh, small_mesh)
+        if turn not in asked:
+            counted.set_pose(big_mesh, big_pose @ bp.rot_z4(turn))
+            asked[turn] = counted.collide(big_mesh, small_mesh)
+        return asked[turn]
 
     centred_collides = collides(0.0)
     inside = BRACKET_INSIDE_ARCMIN / bp.ARCMIN_PER_RAD
@@ -271,8 +275,13 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
     def estimate_of(guess: float | None) -> float | None:
         if guess is not None:
             return guess
-        if not newton:
-            newton.append(_newton_turn(counted, big_mesh, small_mesh, big_pose, levels[0][0], direction))
+        if not newton:  # asked at the exact contact (chords are free there), else at the bracket's free end
+            lo, hi = levels[0]
+            for start in (exact_rad, lo):
+                estimate = _newton_turn(counted, big_mesh, small_mesh, big_pose, start, direction)
+                if estimate is not None and (estimate - lo) * direction > 0.0 and (hi - estimate) * direction > 0.0:
+                    break
+            newton.append(estimate)
         return newton[0]
 
     guesses: list[tuple[float | None, float, str]] = [(hint, 0.0, "hint")] if hint is not None else []
@@ -284,7 +293,7 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
         lo, hi = levels[0]
         if not ((estimate - lo) * direction > margin and (hi - estimate) * direction > margin):
             continue  # expected outside the first bracket: the plain path decides how far to widen
-        found = bisect_predicted(collides, lo, hi, tol_rad, estimate, margin)
+        found = bisect_predicted(collides, lo, hi, tol_rad, estimate, margin, asked=asked)
         if found is not None:
             bracket, how = found[0], label
             break

@@ -195,12 +195,19 @@ def _bisect_move(hits_at: Callable[[float], bool], free: float, touching: float,
     of a part moving into another) that is the plain bisection's bracket, bit for bit. When the
     estimate misses (no proven bracket within any margin) the plain bisection runs."""
     estimate = estimate_at(free) if estimate_at is not None else None
+    asked: dict[float, bool] = {}  # answers shared by the tries: none is asked twice
+
+    def hits(x: float) -> bool:
+        if x not in asked:
+            asked[x] = hits_at(x)
+        return asked[x]
+
     if estimate is not None and min(free, touching) < estimate < max(free, touching):
         for m in ESTIMATE_MARGINS_TOL:
-            found = bisect_predicted(hits_at, free, touching, tol, estimate, m * tol)
+            found = bisect_predicted(hits, free, touching, tol, estimate, m * tol, asked=asked)
             if found is not None:
                 return found[0]
-    return bisect(hits_at, free, touching, tol, check_ends=False)
+    return bisect(hits, free, touching, tol, check_ends=False)
 
 
 def _push_rack(probe: _Probe, angle: float, travel: float, sense: int, reach: float,
