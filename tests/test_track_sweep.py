@@ -304,3 +304,24 @@ def test_a_gap_below_the_window_fails(build_bodies):
     assert not verdicts["seated_tip_gap_in_window"] and not verdicts["min_tip_plate_distance"]
     assert verdicts["no_interference"] and verdicts["contact_proven"] and not result.passed
     assert verdict_pass(result) == 0
+
+
+def test_the_reduce_step_proves_contact_on_the_scene_its_first_work_built(build_bodies, monkeypatch):
+    """The contact proofs of the reduce step use one scene whose BVHs the plan's first work builds
+    (while the workers start), not a second scene built after the sweep."""
+    from gearcheck.executor import SerialExecutor
+    from gearcheck.sweep.plan import run_plan
+
+    run = build_bodies(TEMPLATE)
+    plan = get("track").plan(run.design.params, run.assembly, run.bodies, {"steps_per_cycle": TEST_STEPS})
+    scene = plan.reduce.args[0].scene
+    assert plan.first is not None and scene.built == []
+    results = run_plan(SerialExecutor(), plan)
+    assert sorted(scene.built) == sorted(scene.names)
+
+    def no_new_scene(*_args, **_kwargs):
+        raise AssertionError("the reduce step built a scene of its own")
+
+    monkeypatch.setattr(track_sweep, "Scene", no_new_scene)
+    outcome = plan.reduce(results)
+    assert outcome.summary

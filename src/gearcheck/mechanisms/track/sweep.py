@@ -125,6 +125,7 @@ class _Setup:
     contact_tol: float
     angles: np.ndarray
     started: float
+    scene: Scene  # the reduce step's own (its contact proofs), built while the workers start
     worn_model: TrackModel | None = None  # the same chain re-wrapped at the declared worn pitch
 
 
@@ -160,9 +161,10 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     worn = worn_model(model)
     if worn is not None:
         tasks += [(evaluate_pose, (worn, float(a))) for a in angles]
+    scene = Scene(meshes)
     setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter(),
-                   worn)
-    return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts)
+                   scene, worn)
+    return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts, first=scene.build)
 
 
 # --------------------------------------------------------------------------------------------
@@ -271,7 +273,7 @@ def _proofs(setup: _Setup, x: dict, sleeve_seated: np.ndarray) -> dict:
     poses of the worst sleeve and plate, and the whole link's distance at the sleeve's pose."""
     angles, wrap = setup.angles, setup.model.wrap
     t2 = time.perf_counter()
-    scene = Scene(setup.meshes)
+    scene = setup.scene
 
     def place(index: int) -> tuple[np.ndarray, np.ndarray]:
         a = float(angles[index])
