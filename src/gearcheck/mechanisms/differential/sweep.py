@@ -75,6 +75,7 @@ from typing import Any
 import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
+from gearcheck.geometry.bevel import BevelGearSpec
 from gearcheck.geometry.bevel_mesh import ToothFaces, drive_poses, play_period, zone_azimuth
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.differential.assembly import Layout
@@ -216,6 +217,32 @@ def whole_name(bodies: Mapping[str, Body], layout: Layout, gear: str, ratio: flo
     return f"whole|{_mesh_owner(bodies, layout, gear)}|{ratio!r}"
 
 
+def tooth_of(pose: np.ndarray, point: np.ndarray, spec: BevelGearSpec) -> int:
+    """The tooth of a gear posed at ``pose`` (frame → world) whose faces lie about the world
+    ``point``: its azimuth in the gear's frame over the angular pitch, rounded, as
+    :class:`ToothFaces` numbers the faces by their centroids."""
+    local = pose[:3, :3].T @ (np.asarray(point, float) - pose[:3, 3])
+    return int(np.mod(np.round(np.arctan2(local[1], local[0]) / spec.angular_pitch_rad), spec.teeth))
+
+
+def tooth_patches(meshes: list[MeshData], wanted: Mapping[tuple[str, int], BevelGearSpec]) -> dict[str, MeshData]:
+    """For each (pruned mesh, tooth) wanted: that tooth's faces of the mesh (none when the mesh
+    holds no face of it), named ``mesh|tooth k``. A distance query between the two teeth at an
+    exact contact costs about half of one between the pruned meshes, and finds the same nearest
+    points wherever the contact lies on those teeth."""
+    by_name = {m.name: m for m in meshes}
+    teeth: dict[str, np.ndarray] = {}
+    out = {}
+    for (name, k), spec in wanted.items():
+        mesh = by_name[name]
+        if name not in teeth:
+            teeth[name] = ToothFaces.of(mesh.vertices, mesh.faces, spec).tooth
+        keep = teeth[name] == k
+        if keep.any():
+            out[f"{name}|tooth {k}"] = submesh(mesh, f"{name}|tooth {k}", keep)
+    return out
+
+
 # --------------------------------------------------------------------------------------------
 # One measurement (a worker task: numpy + fcl only)
 
@@ -241,14 +268,15 @@ def _newton_turn(scene: CountedScene, big_mesh: str, small_mesh: str, big_pose: 
 
 def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndarray, small_pose: np.ndarray,
                  exact_rad: float, direction: int, bound_rad: float, tol_rad: float,
-                 hint: float | None = None) -> dict:
+                 hint: float | None = None, teeth: tuple[str, str] | None = None) -> dict:
     """Mesh contact turn of the big gear one way, bracketed around the exact one (contact proven
     from both sides), and whether the centred pose (turn 0) collides.
 
     The bracket is the bisection's, started at the exact contact (widened by the mesh-error bound
     if it does not hold), found in few collisions where the contact can be expected: at ``hint``
     (a congruent pair's measured contact) or else where one distance query puts it
-    (:func:`_newton_turn`); :func:`gearcheck.geometry.bisect.bisect_predicted` replays the
+    (:func:`_newton_turn`; between ``teeth``, the two teeth of the exact contact cut from the
+    meshes, if given, else between the meshes); :func:`gearcheck.geometry.bisect.bisect_predicted` replays the
     halving, asks only the midpoints near the estimate, and proves the final bracket from both
     sides. If the estimate lies outside the first bracket, or the final bracket does not hold, the
     plain bisection runs (widening the bracket as needed)."""
@@ -277,8 +305,12 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
             return guess
         if not newton:  # asked at the exact contact (chords are free there), else at the bracket's free end
             lo, hi = levels[0]
-            for start in (exact_rad, lo):
-                estimate = _newton_turn(counted, big_mesh, small_mesh, big_pose, start, direction)
+            asks = [(big_mesh, small_mesh, exact_rad), (big_mesh, small_mesh, lo)]
+            if teeth is not None:  # the contact's two teeth first: half the cost of the meshes
+                counted.set_pose(teeth[1], small_pose)
+                asks.insert(0, (*teeth, exact_rad))
+            for big, small, start in asks:
+                estimate = _newton_turn(counted, big, small, big_pose, start, direction)
                 if estimate is not None and (estimate - lo) * direction > 0.0 and (hi - estimate) * direction > 0.0:
                     break
             newton.append(estimate)
@@ -317,16 +349,19 @@ def _mesh_names(meshes: list[tuple]) -> list[str]:
     return [name for entry in meshes for name in entry[:2]]
 
 
-def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float) -> dict:
+def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float,
+                    teeth: tuple[str, str] | None = None) -> dict:
     """The mesh contact of each listed pair posed congruently to one exact contact (solved in the
     planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
     the pair itself and its congruent twins (each twin expects the contact where the pair before
-    it had it, and proves its own)."""
-    scene.build(_mesh_names(meshes))  # BVHs first: not part of a measurement's time
+    it had it, and proves its own). ``teeth``: the first pair's two contact teeth
+    (:func:`tooth_patches`), for its distance estimate."""
+    scene.build(_mesh_names(meshes) + list(teeth or ()))  # BVHs first: not part of a measurement's time
     mesh = []
     hint = None
     for bm, sm, bpose, spose, bound in meshes:
-        mesh.append(_bisect_mesh(scene, bm, sm, bpose, spose, exact_rad, direction, bound, tol_rad, hint))
+        mesh.append(_bisect_mesh(scene, bm, sm, bpose, spose, exact_rad, direction, bound, tol_rad, hint,
+                                 teeth if hint is None else None))
         hint = 0.5 * (mesh[-1]["free_rad"] + mesh[-1]["touching_rad"])
     return {"exact_rad": exact_rad, "mesh": mesh}
 
@@ -419,8 +454,20 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
     bound_max_mm = max(bound_mm.values())
 
     meshes = pruned_meshes(bodies, layout, scales)
-    pending, reused, exact, exact_s = _exact_contacts(layout, built, shims, shim_states, names, angles, thermal_at,
-                                                      bound_mm)
+    pending, reused, exact, exact_s, solved = _exact_contacts(layout, built, shims, shim_states, names, angles,
+                                                              thermal_at, bound_mm)
+    # the first pair's two teeth at each exact contact, cut from its meshes for the distance estimate
+    contact_teeth: dict[tuple[int, int], tuple[tuple[str, int], tuple[str, int]]] = {}
+    for n, (_keys, pairs) in enumerate(pending):
+        b, s, *_, variant = pairs[0]
+        for d in DIRECTIONS:
+            c = exact[d][n]
+            big_tooth = tooth_of(solved[n][0].turned(c.angle_rad).pose, c.point, specs.big)
+            small_tooth = tooth_of(solved[n][1].pose, c.point, specs.small)
+            contact_teeth[(n, d)] = ((mesh_name(b, s, d, "big", variant), big_tooth),
+                                     (mesh_name(b, s, d, "small", ""), small_tooth))
+    patches = tooth_patches(meshes, {key: spec for pair in contact_teeth.values()
+                                     for key, spec in zip(pair, (specs.big, specs.small), strict=True)})
     tasks: list[tuple] = []
     owners: list[list[tuple]] = []
     weights: list[int] = []
@@ -428,7 +475,9 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         for d in DIRECTIONS:
             mesh_list = [(mesh_name(b, s, d, "big", variant), mesh_name(b, s, d, "small", ""), bpose, spose, bound)
                          for b, s, bpose, spose, bound, variant in pairs]
-            tasks.append((measure_contact, (exact[d][n].angle_rad, d, mesh_list, tol_rad)))
+            teeth = tuple(f"{name}|tooth {k}" for name, k in contact_teeth[(n, d)])
+            tasks.append((measure_contact, (exact[d][n].angle_rad, d, mesh_list, tol_rad,
+                                            teeth if all(t in patches for t in teeth) else None)))
             owners.append([key + (d,) for key in keys])
             weights.append(len(pairs))
     range_tasks = _range_tasks(params, shims, template_shim, range_shims, angles_per_cycle, tasks, weights)
@@ -439,7 +488,7 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         bound_arcmin=bound_max_mm / d1_half * bp.ARCMIN_PER_RAD, pruned_meshes=len(meshes),
         pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started,
         whole=whole_meshes(bodies, layout, {n: th for n, th in scales.items() if n in FAIL_STATES}))
-    return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
+    return SweepPlan(meshes=meshes + list(patches.values()), tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
                      weights=weights, unit="contact", order=run_order(tasks, range_tasks), first=setup.whole.build,
                      options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
 
@@ -463,7 +512,8 @@ def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list
     """Every distinct exact contact of the sweep (pairs grouped by congruence at each pose), solved
     in one vectorised batch per direction. Returns per distinct pair its owners (shim index,
     state, angle index, big, small) and its mesh pairs (big, small, mesh poses, bound as an angle),
-    how many pairs reuse a solve, the contacts per direction, and the solve's time."""
+    how many pairs reuse a solve, the contacts per direction, the solve's time and the solved
+    gears (big, small) per distinct pair."""
     specs, template_shim = layout.specs, layout.template_shim_mm
     bigs, smalls = layout.big_gears, layout.small_gears
     d1_half = specs.big.outer_pitch_diameter_mm / 2.0
@@ -487,7 +537,7 @@ def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list
                                      for b, s in members]))
     t0 = time.perf_counter()
     exact = {d: bp.big_gear_contacts([p[0] for p in solve], [p[1] for p in solve], d) for d in DIRECTIONS}
-    return pending, reused, exact, time.perf_counter() - t0
+    return pending, reused, exact, time.perf_counter() - t0, solve
 
 
 def _range_tasks(params, shims: list[float], template_shim: float, range_shims: str, angles_per_cycle: int,
