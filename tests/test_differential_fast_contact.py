@@ -165,17 +165,17 @@ def test_estimated_contacts_are_the_plain_bisections(plan_and_run, monkeypatch):
 
 
 def test_contact_teeth_are_the_meshes_teeth_that_hold_the_nearest_points(plan_and_run):
-    """Each task's two tooth patches are exactly the pruned meshes' faces on the tooth the exact
-    contact lies on (as the faces are numbered by their centroids), and the pruned meshes' own
-    nearest points at the exact contact lie on those teeth for nearly every contact (where they
-    do not, the estimate may miss and the bracket is still proven)."""
+    """Each task's two contact teeth, cut from the pruned meshes by the worker, are exactly the
+    meshes' faces on the tooth the exact contact lies on (as the faces are numbered by their
+    centroids), cut once per scene; and the pruned meshes' own nearest points at the exact contact
+    lie on those teeth for nearly every contact (where they do not, the estimate may miss and the
+    bracket is still proven)."""
     from gearcheck.geometry import bevel_play as bp
     from gearcheck.geometry.bevel_mesh import ToothFaces
     from gearcheck.mechanisms.differential import sweep as ds
     from gearcheck.sweep.plan import make_scene
 
-    run, plan = plan_and_run
-    specs = run.assembly.layout.specs
+    _run, plan = plan_and_run
     by_name = {m.name: m for m in plan.meshes}
     scene = make_scene(plan.meshes)
     on_teeth = checked = 0
@@ -187,10 +187,11 @@ def test_contact_teeth_are_the_meshes_teeth_that_hold_the_nearest_points(plan_an
         big_mesh, small_mesh, big_pose, small_pose, _ = meshes[0]
         poses = {big_mesh: big_pose @ bp.rot_z4(exact_rad), small_mesh: small_pose}
         located = {}
-        for mesh, patch, spec in ((big_mesh, teeth[0], specs.big), (small_mesh, teeth[1], specs.small)):
-            whole, part = by_name[mesh], by_name[patch]
+        for mesh, (k, spec) in zip((big_mesh, small_mesh), teeth, strict=True):
+            name = ds.cut_tooth(scene, mesh, k, spec)
+            assert name is not None and ds.cut_tooth(scene, mesh, k, spec) == name
+            whole, part = by_name[mesh], scene.mesh(name)
             tooth = ToothFaces.of(whole.vertices, whole.faces, spec).tooth
-            k = int(patch.rsplit(" ", 1)[1])
             assert len(part.faces) == int(np.sum(tooth == k)) > 0
             assert np.array_equal(np.sort(part.vertices[part.faces].reshape(-1, 9), axis=0),
                                   np.sort(whole.vertices[whole.faces[tooth == k]].reshape(-1, 9), axis=0))
@@ -272,12 +273,8 @@ def test_tasks_run_grouped_by_their_meshes_and_the_exact_range_last(plan_and_run
     groups = [tuple(sorted(n for entry in plan.tasks[i][1][2] for n in entry[:2])) for i in order[:n_mesh]]
     runs = [g for j, g in enumerate(groups) if j == 0 or g != groups[j - 1]]
     assert len(runs) == len(set(groups)) >= 2  # each group's tasks side by side, once
-    # every mesh is used by some task (a pruned mesh, or the contact teeth cut from one of the
-    # task's own); a group uses a few of them
-    teeth = {t for i in order[:n_mesh] for t in plan.tasks[i][1][4] or ()}
-    assert {n for g in groups for n in g} | teeth == {m.name for m in plan.meshes}
-    for i in order[:n_mesh]:
-        assert all(t.split("|tooth ")[0] in plan.tasks[i][1][2][0][:2] for t in plan.tasks[i][1][4] or ())
+    # every pruned mesh is used by some task; a group uses a few of them
+    assert {n for g in groups for n in g} == {m.name for m in plan.meshes}
     assert max(len(g) for g in groups) < len(plan.meshes)
 
 

@@ -165,3 +165,23 @@ def test_a_plan_runs_in_its_order_and_its_results_come_back_in_task_order():
     assert [i for i, _ in run_plan(Older(), plan)] == list(range(40))
     with pytest.raises(ValueError, match="permutation"):
         SweepPlan([tri], tasks, reduce=lambda r: r, order=[0] * 40)
+
+
+def test_the_shared_state_reaches_the_workers_through_a_file_removed_after_the_map():
+    import glob
+    import os
+    import tempfile
+
+    folders = ["/dev/shm", tempfile.gettempdir()]
+
+    def left() -> set[str]:
+        return {f for d in folders if os.path.isdir(d) for f in glob.glob(os.path.join(d, "gearcheck-shared-*"))}
+
+    before = left()
+    tasks = [(float(i), 1.0) for i in range(40)]
+    shared = 2.5  # each worker's state is made from the file's copy, the calling process's from its own
+    assert ProcessExecutor(2).map(scaled, tasks, setup=float, shared=shared) == [2.5 * (x + y) for x, y in tasks]
+    assert left() == before
+    with pytest.raises(ArithmeticError):
+        ProcessExecutor(2).map(_fails_at, [(i,) for i in range(64)], shared=[1, 2, 3])
+    assert left() == before

@@ -18,10 +18,12 @@ import ctypes
 import logging
 import multiprocessing as mp
 import os
+import pickle
 import signal
 import sys
+import tempfile
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol
 
 log = logging.getLogger("gearcheck")
@@ -87,10 +89,34 @@ def _quiet_worker() -> None:
         os._exit(0)
 
 
-def _init_worker(setup, shared) -> None:
+def _init_worker(setup, shared_file: str | None) -> None:
     global _worker_state  # noqa: PLW0603 - one state per worker process, made once
     _quiet_worker()
+    shared = None
+    if shared_file is not None:
+        with open(shared_file, "rb") as fh:
+            shared = pickle.load(fh)
     _worker_state = setup(shared) if setup is not None else shared
+
+
+@contextlib.contextmanager
+def _shared_file(shared: Any) -> Iterator[str | None]:
+    """``shared`` pickled once into a file the spawned workers read as they start (removed on
+    leaving). Passed in the workers' start-up arguments instead, tens of megabytes of meshes would
+    go down a pipe the calling process must wait on until each worker has started and read it
+    (about 0.2 s idle, before it can do any work of its own)."""
+    if shared is None:
+        yield None
+        return
+    folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
+    fd, path = tempfile.mkstemp(prefix="gearcheck-shared-", suffix=".pickle", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            pickle.dump(shared, fh, protocol=pickle.HIGHEST_PROTOCOL)
+        yield path
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(path)
 
 
 class _Spawning:
@@ -161,37 +187,44 @@ class ProcessExecutor:
         ctx = mp.get_context("spawn")
         queue = _Chunks(len(tasks), workers)
         out: list[Any] = [None] * len(tasks)
-        with _Spawning() as spawning:
-            pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared))
-        with pool:  # leaving the block (an error, an interrupt) terminates the workers
-            spawning.deliver()
-            inflight: dict[int, Any] = {}
+        with _shared_file(shared) as shared_file:
+            with _Spawning() as spawning:
+                pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared_file))
+            with pool:  # leaving the block (an error, an interrupt) terminates the workers
+                spawning.deliver()
+                return self._run(pool, fn, tasks, out, queue, workers, setup, shared, progress, weights, first)
 
-            def finish(start: int, results: list) -> None:
-                for i, result in enumerate(results, start):
-                    out[i] = result
-                    _advance(progress, weights, i)
+    @staticmethod
+    def _run(pool: Any, fn, tasks: list, out: list, queue: _Chunks, workers: int, setup, shared, progress, weights,
+             first) -> list:
+        """The map on ``pool`` (``workers − 1`` spawned workers) and this process."""
+        inflight: dict[int, Any] = {}
 
-            def feed() -> None:  # two chunks in flight per spawned worker; one when few tasks are left
-                while queue and len(inflight) < (2 if len(queue) > workers else 1) * (workers - 1):
-                    start, end = queue.take_first()
-                    inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]))
+        def finish(start: int, results: list) -> None:
+            for i, result in enumerate(results, start):
+                out[i] = result
+                _advance(progress, weights, i)
 
+        def feed() -> None:  # two chunks in flight per spawned worker; one when few tasks are left
+            while queue and len(inflight) < (2 if len(queue) > workers else 1) * (workers - 1):
+                start, end = queue.take_first()
+                inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]))
+
+        feed()
+        if first is not None:
+            first()  # while the workers start
+        state = setup(shared) if setup is not None else shared
+        while queue or inflight:
             feed()
-            if first is not None:
-                first()  # while the workers start
-            state = setup(shared) if setup is not None else shared
-            while queue or inflight:
-                feed()
-                for start in [k for k, r in inflight.items() if r.ready()]:
-                    finish(start, inflight.pop(start).get())
-                feed()
-                if queue:  # this process takes the last task in line, the workers the first chunks
-                    start = queue.take_last()
-                    finish(start, [fn(state, *tasks[start])])
-                elif inflight:
-                    next(iter(inflight.values())).wait(0.05)
-            return out
+            for start in [k for k, r in inflight.items() if r.ready()]:
+                finish(start, inflight.pop(start).get())
+            feed()
+            if queue:  # this process takes the last task in line, the workers the first chunks
+                start = queue.take_last()
+                finish(start, [fn(state, *tasks[start])])
+            elif inflight:
+                next(iter(inflight.values())).wait(0.05)
+        return out
 
 
 class _Chunks:

@@ -63,6 +63,14 @@ class Scene:
     def names(self) -> list[str]:
         return list(self._meshes)
 
+    def mesh(self, name: str) -> MeshData:
+        return self._meshes[name]
+
+    def add(self, mesh: MeshData) -> None:
+        """One more body (a part cut from another's mesh by a task, say); its BVH is built on first
+        use. A name already in the scene must stay its mesh: adding it again changes nothing."""
+        self._meshes.setdefault(mesh.name, mesh)
+
     @property
     def built(self) -> list[str]:
         """The bodies whose BVH exists so far."""

@@ -225,22 +225,24 @@ def tooth_of(pose: np.ndarray, point: np.ndarray, spec: BevelGearSpec) -> int:
     return int(np.mod(np.round(np.arctan2(local[1], local[0]) / spec.angular_pitch_rad), spec.teeth))
 
 
-def tooth_patches(meshes: list[MeshData], wanted: Mapping[tuple[str, int], BevelGearSpec]) -> dict[str, MeshData]:
-    """For each (pruned mesh, tooth) wanted: that tooth's faces of the mesh (none when the mesh
-    holds no face of it), named ``mesh|tooth k``. A distance query between the two teeth at an
-    exact contact costs about half of one between the pruned meshes, and finds the same nearest
-    points wherever the contact lies on those teeth."""
-    by_name = {m.name: m for m in meshes}
-    teeth: dict[str, np.ndarray] = {}
-    out = {}
-    for (name, k), spec in wanted.items():
-        mesh = by_name[name]
-        if name not in teeth:
-            teeth[name] = ToothFaces.of(mesh.vertices, mesh.faces, spec).tooth
-        keep = teeth[name] == k
-        if keep.any():
-            out[f"{name}|tooth {k}"] = submesh(mesh, f"{name}|tooth {k}", keep)
-    return out
+def tooth_name(mesh: str, tooth: int) -> str:
+    return f"{mesh}|tooth {tooth}"
+
+
+def cut_tooth(scene: Scene, mesh: str, tooth: int, spec: BevelGearSpec) -> str | None:
+    """The faces of a pruned mesh on one tooth (as :class:`ToothFaces` numbers them), added to the
+    scene once (the worker's; its BVH built on first use) as :func:`tooth_name`; None when the
+    mesh holds no face of that tooth. A distance query between the two teeth at an exact contact
+    costs about half of one between the pruned meshes, and finds the same nearest points
+    wherever the contact lies on those teeth."""
+    name = tooth_name(mesh, tooth)
+    if name not in scene.names:
+        whole = scene.mesh(mesh)
+        keep = ToothFaces.of(whole.vertices, whole.faces, spec).tooth == tooth
+        if not keep.any():
+            return None
+        scene.add(submesh(whole, name, keep))
+    return name
 
 
 # --------------------------------------------------------------------------------------------
@@ -350,12 +352,17 @@ def _mesh_names(meshes: list[tuple]) -> list[str]:
 
 
 def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list[tuple], tol_rad: float,
-                    teeth: tuple[str, str] | None = None) -> dict:
+                    contact_teeth: tuple[tuple[int, BevelGearSpec], tuple[int, BevelGearSpec]] | None = None
+                    ) -> dict:
     """The mesh contact of each listed pair posed congruently to one exact contact (solved in the
     planning process, ``exact_rad``): (big_mesh, small_mesh, big_pose, small_pose, bound_rad) —
     the pair itself and its congruent twins (each twin expects the contact where the pair before
-    it had it, and proves its own). ``teeth``: the first pair's two contact teeth
-    (:func:`tooth_patches`), for its distance estimate."""
+    it had it, and proves its own). ``contact_teeth``: the tooth (and gear design) of the exact
+    contact on the first pair's big and small gear, for its distance estimate (:func:`cut_tooth`)."""
+    teeth = None
+    if contact_teeth is not None:
+        cut = [cut_tooth(scene, name, k, spec) for name, (k, spec) in zip(meshes[0][:2], contact_teeth, strict=True)]
+        teeth = (cut[0], cut[1]) if cut[0] is not None and cut[1] is not None else None
     scene.build(_mesh_names(meshes) + list(teeth or ()))  # BVHs first: not part of a measurement's time
     mesh = []
     hint = None
@@ -456,18 +463,6 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
     meshes = pruned_meshes(bodies, layout, scales)
     pending, reused, exact, exact_s, solved = _exact_contacts(layout, built, shims, shim_states, names, angles,
                                                               thermal_at, bound_mm)
-    # the first pair's two teeth at each exact contact, cut from its meshes for the distance estimate
-    contact_teeth: dict[tuple[int, int], tuple[tuple[str, int], tuple[str, int]]] = {}
-    for n, (_keys, pairs) in enumerate(pending):
-        b, s, *_, variant = pairs[0]
-        for d in DIRECTIONS:
-            c = exact[d][n]
-            big_tooth = tooth_of(solved[n][0].turned(c.angle_rad).pose, c.point, specs.big)
-            small_tooth = tooth_of(solved[n][1].pose, c.point, specs.small)
-            contact_teeth[(n, d)] = ((mesh_name(b, s, d, "big", variant), big_tooth),
-                                     (mesh_name(b, s, d, "small", ""), small_tooth))
-    patches = tooth_patches(meshes, {key: spec for pair in contact_teeth.values()
-                                     for key, spec in zip(pair, (specs.big, specs.small), strict=True)})
     tasks: list[tuple] = []
     owners: list[list[tuple]] = []
     weights: list[int] = []
@@ -475,9 +470,10 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         for d in DIRECTIONS:
             mesh_list = [(mesh_name(b, s, d, "big", variant), mesh_name(b, s, d, "small", ""), bpose, spose, bound)
                          for b, s, bpose, spose, bound, variant in pairs]
-            teeth = tuple(f"{name}|tooth {k}" for name, k in contact_teeth[(n, d)])
-            tasks.append((measure_contact, (exact[d][n].angle_rad, d, mesh_list, tol_rad,
-                                            teeth if all(t in patches for t in teeth) else None)))
+            c = exact[d][n]  # its teeth on the first pair (cut from the meshes by the worker)
+            teeth = ((tooth_of(solved[n][0].turned(c.angle_rad).pose, c.point, specs.big), specs.big),
+                     (tooth_of(solved[n][1].pose, c.point, specs.small), specs.small))
+            tasks.append((measure_contact, (c.angle_rad, d, mesh_list, tol_rad, teeth)))
             owners.append([key + (d,) for key in keys])
             weights.append(len(pairs))
     range_tasks = _range_tasks(params, shims, template_shim, range_shims, angles_per_cycle, tasks, weights)
@@ -488,7 +484,7 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         bound_arcmin=bound_max_mm / d1_half * bp.ARCMIN_PER_RAD, pruned_meshes=len(meshes),
         pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started,
         whole=whole_meshes(bodies, layout, {n: th for n, th in scales.items() if n in FAIL_STATES}))
-    return SweepPlan(meshes=meshes + list(patches.values()), tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
+    return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
                      weights=weights, unit="contact", order=run_order(tasks, range_tasks), first=setup.whole.build,
                      options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
 
