@@ -185,19 +185,18 @@ class ProcessExecutor:
                                         first=first)
         log.debug("running %d tasks on %d processes (this one and %d spawned)", len(tasks), workers, workers - 1)
         ctx = mp.get_context("spawn")
-        queue = _Chunks(len(tasks), workers)
-        out: list[Any] = [None] * len(tasks)
         with _shared_file(shared) as shared_file:
             with _Spawning() as spawning:
                 pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared_file))
             with pool:  # leaving the block (an error, an interrupt) terminates the workers
                 spawning.deliver()
-                return self._run(pool, fn, tasks, out, queue, workers, setup, shared, progress, weights, first)
+                return self._run(pool, fn, tasks, workers, setup, shared, progress, weights, first)
 
     @staticmethod
-    def _run(pool: Any, fn, tasks: list, out: list, queue: _Chunks, workers: int, setup, shared, progress, weights,
-             first) -> list:
+    def _run(pool: Any, fn, tasks: list, workers: int, setup, shared, progress, weights, first) -> list:
         """The map on ``pool`` (``workers − 1`` spawned workers) and this process."""
+        queue = _Chunks(len(tasks), workers)
+        out: list[Any] = [None] * len(tasks)
         inflight: dict[int, Any] = {}
 
         def finish(start: int, results: list) -> None:

@@ -55,6 +55,20 @@ def bisect(flag: Callable[[float], bool], free: float, touching: float, tol: flo
     return Bracket(free, touching)
 
 
+def remembered(flag: Callable[[float], bool]) -> tuple[Callable[[float], bool], dict[float, bool]]:
+    """``flag`` asked once per argument, and its answers (argument → flag): pass both to several
+    tries on one bracket (:func:`bisect_predicted` with ``asked``, then :func:`bisect`) so that
+    none asks again what an earlier one was told."""
+    asked: dict[float, bool] = {}
+
+    def ask(x: float) -> bool:
+        if x not in asked:
+            asked[x] = flag(x)
+        return asked[x]
+
+    return ask, asked
+
+
 def bisect_predicted(flag: Callable[[float], bool], free: float, touching: float, tol: float, estimate: float,
                      margin: float, max_iter: int = DEFAULT_MAX_ITER,
                      asked: dict[float, bool] | None = None) -> tuple[Bracket, int] | None:

@@ -84,7 +84,7 @@ from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, con
                                                            temperature_grid)
 from gearcheck.mechanisms.differential.thermal import GearThermal, thermal_state
 from gearcheck.sweep.bodies import Body, MeshData, submesh
-from gearcheck.geometry.bisect import bisect_predicted
+from gearcheck.geometry.bisect import bisect_predicted, remembered
 from gearcheck.sweep.engine import Scene, bisect_contact
 from gearcheck.sweep.tools import CountedScene
 
@@ -286,14 +286,11 @@ def _bisect_mesh(scene: Scene, big_mesh: str, small_mesh: str, big_pose: np.ndar
     counted = CountedScene(scene)
     counted.set_pose(small_mesh, small_pose)
 
-    asked: dict[float, bool] = {}  # every answer, shared by the tries below
+    def collides_at(turn: float) -> bool:
+        counted.set_pose(big_mesh, big_pose @ bp.rot_z4(turn))
+        return counted.collide(big_mesh, small_mesh)
 
-    def collides(turn: float) -> bool:
-        if turn not in asked:
-            counted.set_pose(big_mesh, big_pose @ bp.rot_z4(turn))
-            asked[turn] = counted.collide(big_mesh, small_mesh)
-        return asked[turn]
-
+    collides, asked = remembered(collides_at)  # every answer, shared by the tries below
     centred_collides = collides(0.0)
     inside = BRACKET_INSIDE_ARCMIN / bp.ARCMIN_PER_RAD
     outside = BRACKET_OUTSIDE_ARCMIN / bp.ARCMIN_PER_RAD

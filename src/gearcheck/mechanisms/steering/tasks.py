@@ -49,7 +49,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.geometry.bisect import Bracket, bisect, bisect_predicted
+from gearcheck.geometry.bisect import Bracket, bisect, bisect_predicted, remembered
 from gearcheck.geometry.rack_pinion_power import tangency_offset
 from gearcheck.mechanism import Assembly
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
@@ -195,13 +195,7 @@ def _bisect_move(hits_at: Callable[[float], bool], free: float, touching: float,
     of a part moving into another) that is the plain bisection's bracket, bit for bit. When the
     estimate misses (no proven bracket within any margin) the plain bisection runs."""
     estimate = estimate_at(free) if estimate_at is not None else None
-    asked: dict[float, bool] = {}  # answers shared by the tries: none is asked twice
-
-    def hits(x: float) -> bool:
-        if x not in asked:
-            asked[x] = hits_at(x)
-        return asked[x]
-
+    hits, asked = remembered(hits_at)  # answers shared by the tries: none is asked twice
     if estimate is not None and min(free, touching) < estimate < max(free, touching):
         for m in ESTIMATE_MARGINS_TOL:
             found = bisect_predicted(hits, free, touching, tol, estimate, m * tol, asked=asked)
