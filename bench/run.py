@@ -7,7 +7,9 @@ file it imported, and the run stops if a side's import comes from anywhere else)
 current runs alternate (B, C, B, C, ...) so that the load of a shared machine falls on both
 alike; each figure is the median of ``--repeat`` runs, and every run's raw times are kept.
 
-Figures: ``check --all`` and ``build --all`` wall time in a fresh process; the steering
+Figures: ``check --all`` and ``build --all`` wall time in a fresh process, with the CAD built
+(an empty CAD cache) and, on the current side, with the CAD from its cache (filled by one untimed
+``build --all`` first; the baseline has no cache, so a re-run is held to its one run); the steering
 template's analytical model (first call and warm median); each mechanism's sweep on 1 worker and
 on every core (built and meshed once per probe, untimed); the differential's play measurements
 and collide calls, and its rate as "poses/s equivalent" (the collide calls the baseline's method
@@ -101,6 +103,7 @@ class Side:
         env = dict(os.environ)
         env["PYTHONPATH"] = str(self.src)
         env.pop("PYTHONHOME", None)
+        env["GEARCHECK_CACHE"] = "off"  # probes build untimed; run_command_all names a cache of its own
         return env
 
     def template(self, mechanism: str) -> Path:
@@ -178,13 +181,18 @@ def run_probe(side: Side, args: list[str]) -> dict:
     return result
 
 
-def run_command_all(side: Side, command: str) -> dict:
-    """``python -m gearcheck COMMAND --all --out TMP`` from the side's root: wall time, exit code."""
-    with tempfile.TemporaryDirectory(prefix=f"gearcheck-bench-{command}-") as tmp:
+def run_command_all(side: Side, command: str, cache: Path | None = None) -> dict:
+    """``python -m gearcheck COMMAND --all --out TMP`` from the side's root: wall time, exit code.
+    The CAD cache (``GEARCHECK_CACHE``; the baseline has none and ignores it) is ``cache``, or, by
+    default, an empty folder of this run's own: the CAD is built as on a first run."""
+    with tempfile.TemporaryDirectory(prefix=f"gearcheck-bench-{command}-") as tmp, \
+            tempfile.TemporaryDirectory(prefix="gearcheck-bench-cad-cache-") as empty:
+        env = {**side.env, "GEARCHECK_CACHE": str(cache if cache is not None else empty)}
         t0 = time.perf_counter()
         try:
-            out = subprocess.run([sys.executable, "-m", "gearcheck", command, "--all", "--out", tmp], check=False,
-                                 cwd=side.root, env=side.env, capture_output=True, text=True, timeout=RUN_TIMEOUT_S)
+            out = subprocess.run([sys.executable, "-m", "gearcheck", command, "--all", "--out", tmp],
+                                 check=False, cwd=side.root, env=env, capture_output=True, text=True,
+                                 timeout=RUN_TIMEOUT_S)
         except subprocess.TimeoutExpired:
             return {"wall_s": None, "returncode": None, "ok": False, "error": "timed out"}
         wall = time.perf_counter() - t0
@@ -203,16 +211,17 @@ class Step:
     key: str
     describe: str
     measure: Callable[[Side], dict]
+    sides: tuple[str, ...] = ("baseline", "current")  # the sides it is measured on
 
 
 def alternate(sides: list[Side], steps: list[Step], repeat: int, raw: dict[str, dict[str, list]]) -> None:
     """``repeat`` rounds of every step, each step on the baseline then on the current code: the
     runs of one figure are spread over the whole benchmark, and each baseline run sits right
     beside its current run, so bursts of load on a shared machine fall on both sides alike."""
-    total, n = len(steps) * repeat * len(sides), 0
+    total, n = sum(len([s for s in sides if s.label in step.sides]) for step in steps) * repeat, 0
     for r in range(repeat):
         for step in steps:
-            for side in sides:
+            for side in (s for s in sides if s.label in step.sides):
                 n += 1
                 log(f"{n}/{total} round {r + 1}/{repeat} {side.label:8s} {step.describe} ...")
                 t0, load = time.perf_counter(), os.getloadavg()[0]
@@ -229,14 +238,19 @@ def sweep_probe(mech: str, jobs: str) -> Callable[[Side], dict]:
     return lambda side: run_probe(side, ["sweep", str(side.template(mech)), "--jobs", jobs])
 
 
-def steps_for(jobs_all: list[int]) -> list[Step]:
+def steps_for(jobs_all: list[int], cad_cache: Path) -> list[Step]:
+    """The steps; ``cad_cache``: the current side's CAD cache for its re-runs (filled first)."""
     jobs = ",".join(str(j) for j in jobs_all)
     steps = [Step("steering_calc", "calc steering",
                   lambda s: run_probe(s, ["calc", str(s.template("steering")), "--repeat", str(CALC_REPEAT)]))]
-    steps += [Step("build_all", "build --all", lambda s: run_command_all(s, "build"))]
+    steps += [Step("build_all", "build --all", lambda s: run_command_all(s, "build")),
+              Step("build_all_cached", "build --all, CAD from the cache",
+                   lambda s: run_command_all(s, "build", cad_cache), ("current",))]
     for mech in TEMPLATES:
         steps.append(Step(f"sweep_{mech}", f"sweep {mech} (jobs {jobs})", sweep_probe(mech, jobs)))
-    steps.append(Step("check_all", "check --all", lambda s: run_command_all(s, "check")))
+    steps += [Step("check_all", "check --all", lambda s: run_command_all(s, "check")),
+              Step("check_all_cached", "check --all, CAD from the cache",
+                   lambda s: run_command_all(s, "check", cad_cache), ("current",))]
     return steps
 
 
@@ -282,7 +296,7 @@ def sweep_figures(runs: list[dict], jobs_all: list[int]) -> dict[str, Any]:
 def side_figures(raw: dict[str, list], jobs_all: list[int], n_cores: int) -> dict[str, Any]:
     """The flat figures of one side (None where its runs failed)."""
     fig: dict[str, Any] = {}
-    for key in ("check_all", "build_all"):
+    for key in ("check_all", "build_all", "check_all_cached", "build_all_cached"):
         good = _ok(raw.get(key, []))
         fig[f"{key}_s"] = median([r["wall_s"] for r in good])
     calc = _ok(raw.get("steering_calc", []))
@@ -345,9 +359,15 @@ def compare(base: dict[str, Any], cur: dict[str, Any], n_cores: int) -> tuple[di
     ratios = {k: ratio(cur.get(k), v) for k, v in base.items()
               if isinstance(v, (int, float)) and not isinstance(v, bool) and isinstance(cur.get(k), (int, float))}
 
-    def row(figure: str, key: str, target: str, met: bool, unit: str, **extra: Any) -> dict:
-        return {"figure": figure, "key": key, "unit": unit, "baseline": base.get(key), "current": cur.get(key),
-                "ratio": ratios.get(key), "target": target, "met": bool(met), **extra}
+    def row(figure: str, key: str, target: str, met: bool, unit: str, base_key: str | None = None,
+            **extra: Any) -> dict:
+        """``base_key``: the baseline figure to compare with, where it has none of this key."""
+        return {"figure": figure, "key": key, "unit": unit, "baseline": base.get(base_key or key),
+                "current": cur.get(key), "ratio": ratio(cur.get(key), base.get(base_key or key)) if base_key
+                else ratios.get(key), "target": target, "met": bool(met), **extra}
+
+    # a re-run with the CAD from the cache, against the baseline's run (it has no cache)
+    recheck = ratio(cur.get("check_all_cached_s"), base.get("check_all_s"))
 
     pool_key = "differential_speedup_1_to_2"
     every_core = (cur.get("differential_default_jobs") == n_cores
@@ -366,7 +386,11 @@ def compare(base: dict[str, Any], cur: dict[str, Any], n_cores: int) -> tuple[di
             _le(cur.get("steering_calc_s"), 0.2), "s", first_call_s=cur.get("steering_calc_first_s")),
         row("track sweep, sprocket poses/s", "track_sprocket_poses_per_s", "≥ 3× baseline",
             _ge(ratios.get("track_sprocket_poses_per_s"), 3.0), "poses/s"),
+        row("check --all, fresh process, CAD from the cache", "check_all_cached_s", "≤ 1/3 of baseline",
+            _le(recheck, 1 / 3), "s", base_key="check_all_s"),
         row("build --all, fresh process", "build_all_s", "≤ 6 s", _le(cur.get("build_all_s"), 6.0), "s"),
+        row("build --all, fresh process, CAD from the cache", "build_all_cached_s", "≤ 6 s",
+            _le(cur.get("build_all_cached_s"), 6.0), "s", base_key="build_all_s"),
         row("worker pool: differential sweep 1 → 2 workers", pool_key if pool_key in cur else
             f"differential_speedup_1_to_{n_cores}", "every core used, ≥ 1.8×",
             every_core and _ge(cur.get(pool_key, cur.get(f"differential_speedup_1_to_{n_cores}")), 1.8), "×",
@@ -466,7 +490,12 @@ def main(argv: list[str] | None = None) -> int:
             log(f"{side.label}: {side.commit[:12]}{' (dirty)' if side.dirty else ''} from {side.root}; "
                 f"checking its import and warming the file cache")
             verify_and_warm(side)
-        alternate(sides, steps_for(jobs_all), repeat, raw)
+        with tempfile.TemporaryDirectory(prefix="gearcheck-bench-cad-cache-") as cad_cache:
+            log("filling the current side's CAD cache (build --all, untimed) ...")
+            filled = run_command_all(current, "build", Path(cad_cache))
+            if not filled["ok"]:
+                raise SystemExit(f"bench: build --all to fill the CAD cache failed: {filled.get('error')}")
+            alternate(sides, steps_for(jobs_all, Path(cad_cache)), repeat, raw)
     figures = {label: side_figures(raw[label], jobs_all, n_cores) for label in raw}
     base, cur = figures["baseline"], figures["current"]
     ratios, targets = compare(base, cur, n_cores)

@@ -1,3 +1,4 @@
+import os
 from pathlib import Path
 
 import pytest
@@ -50,3 +51,8 @@ def template_check(tmp_path_factory):
         return cache[key]
 
     return check
+
+
+# The CAD cache is off for the suite (tests that monkeypatch the CAD must build it); the tests
+# of the cache turn it on in folders of their own. Spawned workers and CLI subprocesses inherit it.
+os.environ["GEARCHECK_CACHE"] = "off"

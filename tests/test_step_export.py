@@ -402,3 +402,25 @@ def test_header_timestamp():
     assert header_timestamp({}).endswith("+00:00")
     with pytest.raises(ParamError, match="SOURCE_DATE_EPOCH"):
         header_timestamp({"SOURCE_DATE_EPOCH": "yesterday"})
+
+
+def test_restamped_file_is_the_file_written_at_that_time(steering_parts, tmp_path, monkeypatch):
+    """A STEP file from the CAD cache gets the time stamp of now: restamping the bytes made at one
+    time gives the bytes made at another, and the file written from them is checked for its size
+    and trailer (not parsed again)."""
+    from gearcheck.cad import step
+
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1000000000")
+    early = step.step_bytes(steering_parts, "nose_wheel_steering", tmp_path / "n.step")
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", EPOCH)
+    late = step.step_bytes(steering_parts, "nose_wheel_steering", tmp_path / "n.step")
+    assert early != late
+    assert step.restamped(early, step.header_timestamp()) == late
+    assert step.restamped(b"ISO-10303-21;\nHEADER;\nENDSEC;\n", step.header_timestamp()) is None
+
+    def parse(*_args, **_kw):
+        raise AssertionError("a file from the cache is not parsed again")
+
+    monkeypatch.setattr(step, "step_products", parse)
+    assert step.write_step(steering_parts, tmp_path / "n.step", "nose_wheel_steering", early) == late
+    assert (tmp_path / "n.step").read_bytes() == late

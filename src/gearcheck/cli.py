@@ -103,6 +103,8 @@ def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
                    help="output folder (default out/NAME; with --all, the parent folder, default out)")
     p.add_argument("--tol", type=float, default=None, metavar="MM", help=TOL_HELP)
     _add_jobs_arg(p, "the sweep" if verb == "check" else "building several templates (--all)")
+    p.add_argument("--no-cache", action="store_true", help="build the solids and meshes anew, neither reading nor "
+                   "writing the CAD cache ($GEARCHECK_CACHE, default ~/.cache/gearcheck; GEARCHECK_CACHE=off: always)")
     what = ("the verdicts, the key figures (paper / model / geometry, exact confirmation)" if verb == "check"
             else "the parts (material, triangles, volume)")
     p.add_argument("--json", action="store_true",
@@ -314,6 +316,8 @@ def _templates_or_one(args) -> list[Design]:
     from gearcheck.pipeline import check_tol
 
     check_tol(args.tol)
+    if args.no_cache:  # read by this process and inherited by the workers it spawns
+        os.environ["GEARCHECK_CACHE"] = "off"
     if args.all == (args.template is not None):
         raise ParamError(args.command, str(args.template), "give one TEMPLATE or --all, not both or neither")
     if not args.all:
@@ -328,9 +332,7 @@ def _templates_or_one(args) -> list[Design]:
 
 
 def _out_folder(args, design: Design) -> Path:
-    if args.all:
-        return (args.out or Path("out")) / design.name
-    return args.out or Path("out") / design.name
+    return (args.out or Path("out")) / design.name if args.all else args.out or Path("out") / design.name
 
 
 def _prepared_folders(args, designs: list[Design]) -> list[Path]:

@@ -118,10 +118,12 @@ class BuildRun:
     files: list[Path] = field(default_factory=list)  # every file of the run (after the swap)
 
 
-def build_parts(design: Design, progress: ProgressFactory = no_progress) -> tuple[Assembly, list[Part]]:
-    """The assembly as data and its solids (CadQuery), no files."""
+def build_parts(design: Design, progress: ProgressFactory = no_progress,
+                assembly: Assembly | None = None) -> tuple[Assembly, list[Part]]:
+    """The assembly as data (given, or made from the parameters) and its solids (CadQuery), no
+    files."""
     impl = design.impl
-    assembly = impl.assembly(design.params)
+    assembly = assembly if assembly is not None else impl.assembly(design.params)
     with progress(f"solids of {design.name}", len(assembly.names), "part") as bar:
         parts = impl.parts(assembly)
         bar.update(len(parts))
@@ -145,23 +147,72 @@ def sweep_bodies(exported: list[ExportedPart]) -> dict[str, Body]:
     }
 
 
+def cad_key(design: Design, assembly: Assembly, tol: float) -> str:
+    """The CAD cache key of a design's solids, meshes and STEP file: what they are made from
+    (its name, the mesh tolerance, the assembly's part and solid specs; not the parameters only
+    the sweep, the verdicts or the report read), with this code and CAD kernel
+    (:func:`gearcheck.cache.key_of`)."""
+    from gearcheck import cache
+
+    return cache.key_of(design.name, float(tol), assembly.mechanism, assembly.parts, assembly.solids)
+
+
+def _cached_cad(design: Design, assembly: Assembly, tol: float) -> tuple[str | None, Any]:
+    """The design's CAD cache key (None with the cache off) and, if the cache holds it, its
+    (time made, parts, meshes, STEP bytes); an entry whose content cannot be used is removed."""
+    from gearcheck import cache
+    from gearcheck.cad.export import cad_from_bytes
+
+    folder = cache.root()
+    if folder is None:
+        return None, None
+    key = cad_key(design, assembly, tol)
+    entry = cache.load(folder, key)
+    if entry is None:
+        return key, None
+    try:
+        parts, meshed = cad_from_bytes(entry.files["cad.pickle"])
+        return key, (entry.created, parts, meshed, entry.files["model.step"])
+    except Exception as exc:  # noqa: BLE001 (whatever the entry holds, the CAD can be built)
+        log.warning("CAD cache entry %s unreadable (%s: %s): building the CAD", key, type(exc).__name__, exc)
+        cache.discard(folder, key)
+        return key, None
+
+
 def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: ProgressFactory,
                 overrides: Sequence[str] = (), geometry: bool = False) -> BuildRun:
     """Solids, meshes, STEP/STL/params.toml/manifest.json (and with ``geometry`` NAME.glb)
-    written into ``folder`` (a staging folder: the caller commits it)."""
-    from gearcheck.cad.export import export_parts
+    written into ``folder`` (a staging folder: the caller commits it). The solids, meshes and
+    STEP file come from the CAD cache when it holds this design's (:func:`_cached_cad`), and go
+    into it when made."""
+    from gearcheck import cache
+    from gearcheck.cad.export import cad_bytes, export_parts
 
     plan = mesh_plan(design, tol_mm)
     tol = plan.tol_mm
-    log.info("stage build: %s (%s), solids", design.name, design.mechanism)
-    assembly, parts = build_parts(design, progress)
+    assembly = design.impl.assembly(design.params)
+    key, cached = _cached_cad(design, assembly, tol)
+    if cached is not None:
+        made, parts, meshed, step = cached
+        log.info("stage build: %s (%s), solids and meshes from the CAD cache (made %s)", design.name,
+                 design.mechanism, made)
+    else:
+        made = meshed = step = None
+        log.info("stage build: %s (%s), solids", design.name, design.mechanism)
+        assembly, parts = build_parts(design, progress, assembly)
     log.info("stage mesh: %s, %d parts at %g mm", design.name, len(parts), tol)
+    source = {"key": key, "reused": cached is not None, "made": made}
     with progress(f"meshing {design.name}", len(parts), "part") as bar:
-        manifest, exported = export_parts(parts, folder, name=design.name, mechanism=design.mechanism,
-                                          params_data=run_params(design, tol), tol_mm=tol,
-                                          extra={"mesh_tolerance": plan.manifest()},
-                                          progress=lambda _name: bar.update(1),
-                                          params_comment=provenance(design, overrides))
+        manifest, exported, step_data = export_parts(
+            parts, folder, name=design.name, mechanism=design.mechanism, params_data=run_params(design, tol),
+            tol_mm=tol, extra={"mesh_tolerance": plan.manifest(), "cad_cache": source},
+            progress=lambda _name: bar.update(1), params_comment=provenance(design, overrides),
+            meshed=meshed, step_data=step)
+        if meshed is not None:
+            bar.update(len(parts))
+    if cached is None and key is not None:
+        meshes = [(e.mesh, e.brep_volume_mm3) for e in exported]
+        cache.store(cache.root(), key, {"cad.pickle": cad_bytes(parts, meshes), "model.step": step_data})
     if geometry:
         from gearcheck.views import scene_of, write_geometry
 
@@ -426,6 +477,7 @@ def write_report(design: Design, folder: Path, result: CheckResult, manifest: di
         "chordal_tolerance_mm": manifest["chordal_tolerance_mm"],
         "triangles": sum(p["triangles"] for p in manifest["parts"]),
         "parts": len(manifest["parts"]),
+        "cad_cache": manifest.get("cad_cache") or {},
     }
     if geometry is not None:
         result.notes.extend(geometry.notes)

@@ -105,7 +105,13 @@ Examples:
   gearcheck check templates/zhurong_differential.toml --set shim.thickness_mm=0.15 --out out/shim015
   gearcheck check templates/eod_track_drive.toml --json | jq '.verdicts[] | [.level, .label]'
   gearcheck check out/eod_track_drive/params.toml --out out/again   (reproduces a run)
-  gearcheck check --all --jobs 2 --open"""
+  gearcheck check --all --jobs 2 --open
+
+The CAD cache: a design's solids, meshes and STEP file are kept (in $GEARCHECK_CACHE, default
+~/.cache/gearcheck) by what they are built from, so a re-check that changes only what the sweep,
+the verdicts or the report read (temperatures, targets, tolerances of the sweep) skips the CAD
+kernel, with the same figures and files (the manifest and the report say where the CAD came
+from). --no-cache builds anew."""
 
 BUILD_EXAMPLES = """\
 Examples:

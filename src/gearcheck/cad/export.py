@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import pickle
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -27,8 +28,8 @@ from gearcheck.cad.step import StepWriteError, appearance, write_step
 from gearcheck.output import atomic_write_bytes, atomic_write_text, ensure_out_dir
 from gearcheck.params.common import to_toml
 
-__all__ = ["ExportedPart", "StepWriteError", "cad_assembly", "export_parts", "posed", "sha256", "stl_bytes",
-           "write_step"]
+__all__ = ["ExportedPart", "StepWriteError", "cad_assembly", "cad_bytes", "cad_from_bytes", "export_parts",
+           "mesh_parts", "posed", "sha256", "stl_bytes", "write_step"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +74,34 @@ def cad_assembly(parts: list[Part], assembly_name: str) -> cq.Assembly:
     return assy
 
 
+def mesh_parts(parts: list[Part], tol_mm: float = CHORDAL_TOL_MM, progress=None) -> list[tuple[TriMesh, float]]:
+    """(mesh in the part's own frame, B-rep volume in mm³) of every part, in order; copies share
+    a solid, and are meshed once (they share the mesh). ``progress`` (optional) is called with
+    each part name as it is meshed. Meshing leaves each solid carrying its triangulation."""
+    meshed: dict[int, tuple[TriMesh, float]] = {}
+    out = []
+    for part in parts:
+        if progress:
+            progress(part.name)
+        if id(part.solid) not in meshed:
+            meshed[id(part.solid)] = (mesh_shape(part.solid, tol_mm), float(volume_mm3(part.solid)))
+        out.append(meshed[id(part.solid)])
+    return out
+
+
+def cad_bytes(parts: list[Part], meshed: list[tuple[TriMesh, float]]) -> bytes:
+    """The parts (solids with their triangulations: OCCT's binary B-rep) and their meshes as one
+    pickle, shared solids and meshes shared once, for :mod:`gearcheck.cache`."""
+    return pickle.dumps((parts, meshed), protocol=5)
+
+
+def cad_from_bytes(data: bytes) -> tuple[list[Part], list[tuple[TriMesh, float]]]:
+    """What :func:`cad_bytes` wrote: the same solids (bit for bit, triangulations included, so
+    what is measured on them later sees the same B-rep) and meshes."""
+    parts, meshed = pickle.loads(data)
+    return parts, meshed
+
+
 def export_parts(
     parts: list[Part],
     folder: Path,
@@ -84,27 +113,28 @@ def export_parts(
     extra: dict | None = None,
     progress=None,
     params_comment: str = "",
-) -> tuple[dict, list[ExportedPart]]:
+    meshed: list[tuple[TriMesh, float]] | None = None,
+    step_data: bytes | None = None,
+) -> tuple[dict, list[ExportedPart], bytes]:
     """Mesh and write every part, the STEP assembly, params.toml and manifest.json; returns the
-    manifest and the exported parts (meshes in their own frames). ``progress`` (optional) is
-    called with each part name as it is meshed."""
+    manifest, the exported parts (meshes in their own frames) and the STEP file's bytes.
+    ``progress`` (optional) is called with each part name as it is meshed. ``meshed`` (one
+    :func:`mesh_parts` entry per part) and ``step_data`` (a STEP file of these parts, its header
+    stamped again now) are used instead of meshing and writing the STEP anew: a design's CAD
+    from the cache."""
     folder = ensure_out_dir(folder)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ValueError(f"part names must be unique: {names}")
+    if meshed is None:
+        meshed = mesh_parts(parts, tol_mm, progress)
     exported: list[ExportedPart] = []
-    meshed: dict[int, tuple[TriMesh, float]] = {}  # copies share a solid: mesh it once
-    for part in parts:
-        if progress:
-            progress(part.name)
-        if id(part.solid) not in meshed:
-            meshed[id(part.solid)] = (mesh_shape(part.solid, tol_mm), float(volume_mm3(part.solid)))
-        mesh, volume = meshed[id(part.solid)]
+    for part, (mesh, volume) in zip(parts, meshed, strict=True):
         stl = folder / f"{part.name}.stl"
         atomic_write_bytes(stl, stl_bytes(posed(mesh, part.pose), part.name))
         exported.append(ExportedPart(part, mesh, stl, volume))
     step = folder / f"{name}.step"
-    write_step(parts, step, name)
+    step_data = write_step(parts, step, name, step_data)
     params_file = folder / "params.toml"
     atomic_write_text(params_file, to_toml(params_data, comment=params_comment))
 
@@ -145,4 +175,4 @@ def export_parts(
     if extra:
         manifest.update(extra)
     atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
-    return manifest, exported
+    return manifest, exported, step_data

@@ -67,6 +67,8 @@ log = logging.getLogger("gearcheck")
 
 STEP_TRAILER = b"END-ISO-10303-21;"
 TIMESTAMP_FORMAT = "%Y-%m-%dT%H:%M:%S+00:00"
+# FILE_NAME('name', 'time stamp', ...: the stamp as TIMESTAMP_FORMAT writes it
+_STAMP = re.compile(rb"FILE_NAME\('(?:[^']|'')*',\s*'(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\d\+00:00)'")
 AUTHOR = "gearcheck"
 ORGANISATION = "gearcheck"
 ORIGINATING_SYSTEM = f"gearcheck {__version__}"
@@ -416,10 +418,11 @@ def step_products(path: Path, shown: Path | None = None) -> tuple[dict[str, int]
 
 
 def verify_step_file(path: Path, parts: Sequence[Part], assembly_name: str, size: int,
-                     shown: Path | None = None) -> None:
-    """The file as written: ``size`` bytes, the ISO 10303-21 trailer, and read back, the root
-    product plus one product per part by name, each with the part's solids, and one assembly
-    occurrence per part in order. StepWriteError naming ``shown`` (default ``path``)."""
+                     shown: Path | None = None, products: bool = True) -> None:
+    """The file as written: ``size`` bytes, the ISO 10303-21 trailer, and (with ``products``)
+    read back, the root product plus one product per part by name, each with the part's solids,
+    and one assembly occurrence per part in order. StepWriteError naming ``shown`` (default
+    ``path``)."""
     path = Path(path)
     shown = shown or path
     actual = path.stat().st_size
@@ -429,28 +432,54 @@ def verify_step_file(path: Path, parts: Sequence[Part], assembly_name: str, size
         fh.seek(max(0, size - 64))
         if not fh.read().rstrip().endswith(STEP_TRAILER):
             raise StepWriteError(shown, f"no {STEP_TRAILER.decode()} trailer on disk")
-    products, occurrences = step_products(path, shown)
+    if not products:
+        return
+    found, occurrences = step_products(path, shown)
     expected = {assembly_name: 0} | {p.name: solid_count(p.solid.wrapped) for p in parts}
-    if products != expected:
-        raise StepWriteError(shown, f"read back, products and solids {products} instead of {expected}")
+    if found != expected:
+        raise StepWriteError(shown, f"read back, products and solids {found} instead of {expected}")
     if occurrences != [p.name for p in parts]:
         raise StepWriteError(shown, f"read back, instances {occurrences} instead of {[p.name for p in parts]}")
 
 
-def write_step(parts: Sequence[Part], path: Path, assembly_name: str) -> int:
-    """Write the STEP assembly to ``path`` atomically and check it; returns its size in bytes.
-    StepWriteError (an OSError whose ``filename`` is ``path``) on any failure, leaving neither
-    the file nor a temporary file behind."""
+def restamped(data: bytes, timestamp: str) -> bytes | None:
+    """A STEP file's bytes with its header's time stamp replaced by ``timestamp`` (of
+    :data:`TIMESTAMP_FORMAT`, so the header keeps its length and line breaks), or None where the
+    header holds no such stamp."""
+    stamp = timestamp.encode("ascii")
+    end = data.find(b"ENDSEC;")
+    head = data[:end]
+    found = list(_STAMP.finditer(head)) if end > 0 else []
+    if len(found) != 1 or len(found[0].group(1)) != len(stamp):
+        return None
+    m = found[0]
+    return head[:m.start(1)] + stamp + head[m.end(1):] + data[end:]
+
+
+def write_step(parts: Sequence[Part], path: Path, assembly_name: str, data: bytes | None = None) -> bytes:
+    """Write the STEP assembly to ``path`` atomically and check it; returns the bytes written.
+    ``data``: a STEP file these parts made before (from the cache), stamped now and checked for
+    its size and trailer as written (its products were read back when it was made); else the
+    file is made now and read back. StepWriteError (an OSError whose ``filename`` is ``path``)
+    on any failure, leaving neither the file nor a temporary file behind."""
     path = Path(path)
     names = [p.name for p in parts]
     if assembly_name in names or len(set(names)) != len(names):
         raise ValueError(f"STEP product names must be unique: {assembly_name!r} and {names}")
-    data = step_bytes(parts, assembly_name, path)
+    stamped = restamped(data, header_timestamp()) if data is not None else None
+    if stamped is None:
+        stamped = step_bytes(parts, assembly_name, path)
+        products = True
+    else:
+        products = False
+
+    def check(tmp: Path) -> None:
+        verify_step_file(tmp, parts, assembly_name, len(stamped), shown=path, products=products)
+
     try:
-        replace_atomically(path, data, check=lambda tmp: verify_step_file(tmp, parts, assembly_name, len(data),
-                                                                         shown=path))
+        replace_atomically(path, stamped, check=check)
     except StepWriteError:
         raise
     except OSError as exc:  # EFBIG under ulimit -f, ENOSPC, EACCES…
         raise StepWriteError(path, exc.strerror or str(exc), exc.errno) from exc
-    return len(data)
+    return stamped
