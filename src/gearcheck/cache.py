@@ -111,6 +111,8 @@ def load(folder: Path | None, key: str) -> Entry | None:
     if folder is None:
         return None
     where = folder / key
+    if not where.is_dir():
+        return None
     try:
         index = json.loads((where / INDEX).read_text())
         files = {}
@@ -120,9 +122,7 @@ def load(folder: Path | None, key: str) -> Entry | None:
                 raise ValueError(f"{name} does not match its index")
             files[name] = data
         created = str(index["created"])
-    except FileNotFoundError:
-        return None
-    except (OSError, ValueError, KeyError, TypeError) as exc:
+    except (OSError, ValueError, KeyError, TypeError) as exc:  # a file missing, cut short or edited
         log.warning("CAD cache entry %s unreadable (%s): removed, building the CAD", where, exc)
         shutil.rmtree(where, ignore_errors=True)
         return None

@@ -144,7 +144,8 @@ def _run_line(template: str, build: dict, inputs: Sequence[InputRow]) -> str:
     if build.get("triangles", "") != "":
         parts.append(f"{_e(build['triangles'])} triangles in {_e(build.get('parts', ''))} parts")
     if (build.get("cad_cache") or {}).get("reused"):
-        parts.append(f"solids, meshes and STEP from the CAD cache (made {_e(build['cad_cache'].get('made'))})")
+        made = str(build["cad_cache"].get("made") or "").replace("T", " ").replace("Z", " UTC")
+        parts.append(f"solids, meshes and STEP from the CAD cache (made {_e(made)})")
     return "<p class='meta'>" + " · ".join(parts) + "</p>"
 
 
