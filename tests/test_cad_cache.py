@@ -63,7 +63,7 @@ def test_eviction_keeps_the_most_recently_used(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == [".cafe-writing", "new", "old"]
 
 
-def test_key_follows_the_geometry_not_the_sweep_settings():
+def test_key_follows_the_geometry_not_the_sweep_settings(monkeypatch):
     from gearcheck.design import load_template
     from gearcheck.pipeline import cad_key
 
@@ -77,6 +77,32 @@ def test_key_follows_the_geometry_not_the_sweep_settings():
     assert key("shim.thickness_mm=0.15") != base  # the gears sit elsewhere
     assert key(tol=0.005) != base
     assert cache.key_of("a") != cache.key_of("b")
+    monkeypatch.setattr(cache, "code_digest", lambda _cls: "the mechanism's code, edited")
+    assert key() != base
+
+
+def test_a_plugins_own_code_is_in_the_key(tmp_path, monkeypatch):
+    """A mechanism from outside gearcheck keys its CAD by its own package's source: an edit of its
+    CAD hook is a new key."""
+    from gearcheck.mechanisms.steering.mechanism import Steering
+
+    package = tmp_path / "myplugin"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "cad.py").write_text("WIDTH = 1.0\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    import myplugin  # noqa: F401
+
+    class Plugin:
+        pass
+
+    Plugin.__module__ = "myplugin.mechanism"
+    before = cache.code_digest(Plugin)
+    assert before == cache.code_digest(Plugin) and before != cache.code_digest(Steering)
+    assert cache.code_digest(Steering) == cache.source_digest()
+    (package / "cad.py").write_text("WIDTH = 2.0\n")
+    cache._tree_digest.cache_clear()  # a new process reads the edited file
+    assert cache.code_digest(Plugin) != before
 
 
 def _files(folder: Path) -> dict[str, bytes]:

@@ -13,8 +13,9 @@ entries used longest ago are removed.
 
 The key (:func:`key_of`) is the SHA-256 of what the files are made from: this cache's format,
 gearcheck's version and a digest of its own source files (any code change is a new key), the
-CAD kernel's versions, and the caller's inputs (the design's name, the mesh tolerance and the
-assembly's part and solid specs). The files are pickles, which run code when read: the cache
+CAD kernel's versions, and the caller's inputs (the design's name, the mesh tolerance, the
+assembly's part and solid specs, and the source of the mechanism's own package when it is not
+gearcheck's: :func:`code_digest`). The files are pickles, which run code when read: the cache
 folder must be writable only by its user (as the default in the home folder is).
 """
 
@@ -28,6 +29,7 @@ import logging
 import os
 import pickle
 import shutil
+import sys
 import tempfile
 import time
 from collections.abc import Mapping
@@ -58,16 +60,35 @@ def root(environ: Mapping[str, str] | None = None) -> Path | None:
     return (Path(base) if base else Path.home() / ".cache") / "gearcheck"
 
 
-@functools.lru_cache(maxsize=1)
+@functools.lru_cache(maxsize=8)
+def _tree_digest(root: Path) -> str:
+    """SHA-256 of every ``.py`` file under ``root`` (a package folder) or of ``root`` itself (a
+    single module), by relative path and content."""
+    h = hashlib.sha256()
+    files = sorted(root.rglob("*.py")) if root.is_dir() else [root]
+    for path in files:
+        h.update(str(path.relative_to(root) if root.is_dir() else path.name).encode() + b"\0")
+        h.update(path.read_bytes() + b"\0")
+    return h.hexdigest()
+
+
 def source_digest() -> str:
     """SHA-256 of gearcheck's own Python source (every ``.py`` under the package, by relative
     path): a key ingredient, so an edited checkout never reads an entry made by other code."""
-    package = Path(__file__).resolve().parent
-    h = hashlib.sha256()
-    for path in sorted(package.rglob("*.py")):
-        h.update(str(path.relative_to(package)).encode() + b"\0")
-        h.update(path.read_bytes() + b"\0")
-    return h.hexdigest()
+    return _tree_digest(Path(__file__).resolve().parent)
+
+
+def code_digest(cls: type) -> str:
+    """SHA-256 of the source of the package ``cls`` comes from (its top-level package's ``.py``
+    files, or its module's file): a mechanism registered from outside gearcheck (a plugin) keys
+    its CAD by its own code too. "unknown" where the source cannot be found (then only the
+    rest of the key tells entries apart)."""
+    top = sys.modules.get(cls.__module__.split(".")[0])
+    file = getattr(top, "__file__", None)
+    if not file:
+        return "unknown"
+    path = Path(file).resolve()
+    return _tree_digest(path.parent if path.name == "__init__.py" else path)
 
 
 @functools.lru_cache(maxsize=1)

@@ -150,11 +150,12 @@ def sweep_bodies(exported: list[ExportedPart]) -> dict[str, Body]:
 def cad_key(design: Design, assembly: Assembly, tol: float) -> str:
     """The CAD cache key of a design's solids, meshes and STEP file: what they are made from
     (its name, the mesh tolerance, the assembly's part and solid specs; not the parameters only
-    the sweep, the verdicts or the report read), with this code and CAD kernel
-    (:func:`gearcheck.cache.key_of`)."""
+    the sweep, the verdicts or the report read), with this code, the mechanism's own (a plugin's
+    package) and this CAD kernel (:func:`gearcheck.cache.key_of`)."""
     from gearcheck import cache
 
-    return cache.key_of(design.name, float(tol), assembly.mechanism, assembly.parts, assembly.solids)
+    return cache.key_of(design.name, float(tol), assembly.mechanism, assembly.parts, assembly.solids,
+                        cache.code_digest(type(design.impl)))
 
 
 def _cached_cad(design: Design, assembly: Assembly, tol: float) -> tuple[str | None, Any]:
