@@ -43,6 +43,9 @@ def test_store_load_and_tampering(tmp_path, caplog):
         assert cache.load(tmp_path, "k1") is None
     assert "unreadable" in caplog.text and not (tmp_path / "k1").exists()
     assert cache.store(tmp_path, "k1", files) and cache.load(tmp_path, "k1").files == files
+    (tmp_path / "k1" / "a.bin").write_bytes(b"z" * 1000)  # edited, the same size: its SHA-256 tells
+    assert cache.load(tmp_path, "k1") is None and not (tmp_path / "k1").exists()
+    assert cache.store(tmp_path, "k1", files)
     (tmp_path / "k1" / "b.bin").unlink()  # a file gone: the entry goes too, to be written again
     assert cache.load(tmp_path, "k1") is None and not (tmp_path / "k1").exists()
     assert cache.store(tmp_path, "k1", files)
