@@ -260,19 +260,31 @@ def test_shared_meshes_decide_contact_as_the_scaled_ones(plan_and_run):
     assert math.isfinite(setup.bound_arcmin)
 
 
-def test_tasks_run_grouped_by_their_meshes_and_the_exact_range_last(plan_and_run):
+def test_tasks_run_grouped_by_their_meshes_in_two_halves_with_the_exact_range_between(plan_and_run):
+    """Two processes (workers from the front, the calling process from the back) each build the
+    BVHs of their own half of the mesh groups and meet in the exact range tasks (no mesh)."""
     from gearcheck.mechanisms.differential import sweep as ds
 
     _, plan = plan_and_run
     order = plan.order
     assert sorted(order) == list(range(len(plan.tasks)))
     kinds = [plan.tasks[i][0] for i in order]
-    n_mesh = kinds.count(ds.measure_contact)
-    assert all(k is ds.measure_contact for k in kinds[:n_mesh]) and all(
-        k is ds.exact_range_task for k in kinds[n_mesh:])
-    groups = [tuple(sorted(n for entry in plan.tasks[i][1][2] for n in entry[:2])) for i in order[:n_mesh]]
+    ranged = [j for j, k in enumerate(kinds) if k is ds.exact_range_task]
+    assert ranged == list(range(ranged[0], ranged[-1] + 1))  # side by side
+    front, back = order[:ranged[0]], order[ranged[-1] + 1:]
+    assert all(kinds[j] is ds.measure_contact for j in range(len(kinds)) if j not in ranged)
+
+    def groups_of(part: list[int]) -> list[tuple]:
+        return [tuple(sorted(n for entry in plan.tasks[i][1][2] for n in entry[:2])) for i in part]
+
+    groups = groups_of(front) + groups_of(back)
     runs = [g for j, g in enumerate(groups) if j == 0 or g != groups[j - 1]]
     assert len(runs) == len(set(groups)) >= 2  # each group's tasks side by side, once
+    assert not set(groups_of(front)) & set(groups_of(back))  # no mesh group in both halves
+    assert not {n for g in groups_of(front) for n in g} & {n for g in groups_of(back) for n in g}
+    weight = [sum(plan.weights[i] for i in part) for part in (front, back)]
+    largest = max(sum(plan.weights[i] for i in front + back if groups_of([i])[0] == g) for g in set(groups))
+    assert front and back and abs(weight[0] - weight[1]) <= largest  # the halves about even
     # every pruned mesh is used by some task; a group uses a few of them
     assert {n for g in groups for n in g} == {m.name for m in plan.meshes}
     assert max(len(g) for g in groups) < len(plan.meshes)

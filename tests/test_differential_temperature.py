@@ -139,6 +139,26 @@ def test_template_binds_only_in_storage_with_an_onset(template, grid):
     assert grid.depth_um(deep) == pytest.approx(-deep / bp.ARCMIN_PER_RAD * d1_half * 1e3, rel=1e-12)
 
 
+def test_an_onset_solved_by_the_range_task_is_the_one_the_reduce_step_would_solve(template, grid):
+    """The sweep's range tasks solve the crossings between their own temperatures (beside the other
+    tasks); the reduce step takes them as they are and solves only a crossing that falls between
+    two tasks' temperatures: the same onset, bit for bit, either way."""
+    from gearcheck.mechanisms.differential.sweep import exact_range_task
+
+    shim, temps = template.shim.thickness_mm, grid.temperatures_C
+    i = int(np.flatnonzero(np.diff(np.sign(grid.least_arcmin)))[0])  # the crossing: temps[i], temps[i + 1]
+    inside = exact_range_task(None, template, shim, [float(t) for t in temps[max(i - 1, 0):i + 2]], tp.ANGLES_PER_CYCLE)
+    assert list(inside["onsets"].values()) == [grid.cold_onset_C] and inside["onset_s"] > 0.0
+    # split between two tasks: neither sees the crossing, the reduce step solves it
+    parts = [exact_range_task(None, template, shim, [float(temps[k])], tp.ANGLES_PER_CYCLE) for k in (i, i + 1)]
+    assert all(p["onsets"] == {} for p in parts)
+    merged = tp.merge_plays([p["plays"] for p in parts])
+    assert tp.range_check(template, shim, plays=merged).onsets_C == (grid.cold_onset_C,)
+    # a crossing given as solved is taken, not solved again
+    key = next(iter(inside["onsets"]))
+    assert tp.range_check(template, shim, plays=merged, solved={key: -99.5}).onsets_C == (-99.5,)
+
+
 @pytest.mark.parametrize("shim, level", [(0.0, "fail"), (0.15, "pass")])
 def test_range_levels_follow_the_shim(template, shim, level):
     r = tp.range_check(template, shim, grid=False)

@@ -106,6 +106,33 @@ def test_chunks_cover_every_task_once_and_shrink_towards_the_end():
             assert sizes[-1] <= 2 < sizes[0]
 
 
+def test_weighted_chunks_even_out_the_work_where_heavy_tasks_follow_light_ones():
+    """Many light tasks, then a run of heavy ones (a sweep's mesh contacts, then its exact range
+    tasks): a chunk weighs no more than the guided share of the work, so a worker that reaches the
+    heavy run takes a few of them, not a count's worth; every task once, in order within a chunk."""
+    weights = [1.0] * 264 + [16.0] * 21 + [1.0] * 264
+    n, processes = len(weights), 2
+    queue = _Chunks(n, processes, weights)
+    total = sum(weights)
+    taken: list[int] = []
+    chunk_weights = []
+    while queue:
+        start, end = queue.take_first()
+        assert end > start
+        taken.extend(range(start, end))
+        w = sum(weights[start:end])
+        assert end - start == 1 or w <= max(1.0, total // (8 * processes))  # never more than the cap
+        chunk_weights.append(w)
+    assert taken == list(range(n))
+    # the heavy run is spread over several chunks, each within the cap (by count, one chunk of
+    # up to n // 16 = 34 tasks could have held all 21 heavy ones: 336 of the 864 weight)
+    assert max(chunk_weights) <= total // (8 * processes) < 16.0 * 21
+    # unit weights: the same chunks as without weights
+    a, b = _Chunks(200, 2), _Chunks(200, 2, [1] * 200)
+    while a or b:
+        assert a.take_first() == b.take_first()
+
+
 def _marked(_state: None, i: int) -> tuple[int, bool]:
     import os
 

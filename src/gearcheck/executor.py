@@ -13,9 +13,11 @@ of them.
 
 from __future__ import annotations
 
+import bisect
 import contextlib
 import ctypes
 import logging
+import math
 import multiprocessing as mp
 import os
 import pickle
@@ -195,7 +197,7 @@ class ProcessExecutor:
     @staticmethod
     def _run(pool: Any, fn, tasks: list, workers: int, setup, shared, progress, weights, first) -> list:
         """The map on ``pool`` (``workers − 1`` spawned workers) and this process."""
-        queue = _Chunks(len(tasks), workers)
+        queue = _Chunks(len(tasks), workers, weights)
         out: list[Any] = [None] * len(tasks)
         inflight: dict[int, Any] = {}
 
@@ -230,14 +232,19 @@ class _Chunks:
     """The tasks not yet taken, [lo, hi): the spawned workers take chunks from the front, this
     process one task at a time from the back (so each keeps to its own run of tasks and the
     meshes they use, and this process tops up the workers' queue after every task it runs).
-    Guided sizes: a chunk is at most 1/(8·processes) of all tasks (few round trips) and at most
+    Guided sizes, in task weights (the plan's estimate of each task's work; 1 each without):
+    a chunk weighs at most 1/(8·processes) of all tasks (few round trips) and at most
     1/(3·processes) of what is left, so chunks shrink towards the end and no process waits long
-    for another's last chunk; and with no more tasks left than processes, a worker gets one only
-    when it has none in flight (the last few go to whoever is free, this process included)."""
+    for another's last chunk, even where a few heavy tasks follow many light ones; a chunk holds
+    at least one task. With no more tasks left than processes, a worker gets one only when it has
+    none in flight (the last few go to whoever is free, this process included)."""
 
-    def __init__(self, n: int, processes: int):
+    def __init__(self, n: int, processes: int, weights: Sequence[float] | None = None):
         self.lo, self.hi, self.processes = 0, n, processes
-        self.largest = max(1, n // (8 * processes))
+        self._cum = [0.0]  # weight of the first i tasks
+        for w in weights if weights is not None else [1.0] * n:
+            self._cum.append(self._cum[-1] + max(float(w), 0.0))
+        self.largest = max(1.0, float(math.floor(self._cum[-1] / (8 * processes))))
 
     def __bool__(self) -> bool:
         return self.hi > self.lo
@@ -247,8 +254,10 @@ class _Chunks:
 
     def take_first(self) -> tuple[int, int]:
         """The next chunk from the front: (start, end)."""
-        size = max(1, min(self.largest, -(-len(self) // (3 * self.processes))))
-        start, self.lo = self.lo, min(self.hi, self.lo + size)
+        left = self._cum[self.hi] - self._cum[self.lo]
+        most = min(self.largest, math.ceil(left / (3 * self.processes)))
+        end = bisect.bisect_right(self._cum, self._cum[self.lo] + most, self.lo + 1, self.hi + 1) - 1
+        start, self.lo = self.lo, max(self.lo + 1, end)
         return start, self.lo
 
     def take_last(self) -> int:

@@ -126,7 +126,7 @@ def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
             by_key[key] = {**mesh, "exact_rad": result["exact_rad"]}
     t0 = time.perf_counter()
     ranges = _ranges(setup, results)
-    onset_s = time.perf_counter() - t0
+    onset_s = time.perf_counter() - t0 + sum(results[task]["onset_s"] for _, task in setup.range_tasks)
     wall_s = time.perf_counter() - setup.started
     data = _arrays(setup, by_key, ranges)
     summary = _summary(setup, data, by_key)
@@ -138,10 +138,12 @@ def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
 def _ranges(setup: SweepSetup, results: list[dict]) -> dict[int, RangeCheck]:
     """The exact range per shim from its chunks, with the onset of binding solved."""
     chunks: dict[int, list] = {}
+    solved: dict[int, dict] = {}
     for i, task in setup.range_tasks:
         chunks.setdefault(i, []).append(results[task]["plays"])
-    return {i: range_check(setup.params, setup.shims[i], specs=setup.layout.specs, plays=merge_plays(parts))
-            for i, parts in chunks.items()}
+        solved.setdefault(i, {}).update(results[task]["onsets"])
+    return {i: range_check(setup.params, setup.shims[i], specs=setup.layout.specs, plays=merge_plays(parts),
+                           solved=solved[i]) for i, parts in chunks.items()}
 
 
 def _arrays(setup: SweepSetup, by_key: dict, ranges: dict[int, RangeCheck]) -> SweepData:
@@ -347,7 +349,8 @@ def _timings(setup: SweepSetup, by_key: dict, wall_s: float, range_s: float, ons
     """Speed of the sweep: FCL queries per second (over the time spent on the meshes, per worker),
     mesh contacts (one pair, one way, bracketed) per second of the sweep's wall time, one play
     measurement (one big gear against one small gear, both ways, on the meshes), one exact
-    contact solve (the vectorised batch), the exact range (worker time) and its onset solves, wall time of the sweep."""
+    contact solve (the vectorised batch), the exact range (worker time) and its onset solves (in the
+    range tasks, and here for a crossing between two tasks' temperatures), wall time of the sweep."""
     calls = sum(r["calls"] for r in by_key.values())  # FCL queries: collisions and distances
     mesh_s = sum(r["mesh_s"] for r in by_key.values())
     pair_play_s = [by_key[key]["mesh_s"] + by_key[key[:5] + (-1,)]["mesh_s"] for key in by_key if key[5] == 1]

@@ -79,7 +79,8 @@ from gearcheck.geometry.bevel import BevelGearSpec
 from gearcheck.geometry.bevel_mesh import ToothFaces, drive_poses, play_period, zone_azimuth
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.differential.assembly import Layout
-from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, congruent_groups,
+from gearcheck.mechanisms.differential.poses import gear_specs
+from gearcheck.mechanisms.differential.temperature import (ANGLES_PER_CYCLE, congruent_groups, crossings,
                                                            exact_plays_or_unsolved, meshed_states, placed_gears,
                                                            temperature_grid)
 from gearcheck.mechanisms.differential.thermal import GearThermal, thermal_state
@@ -373,10 +374,15 @@ def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list
 def exact_range_task(_scene: Scene, params, shim_mm: float, temperatures_C: list[float], angles_per_cycle: int
                      ) -> dict:
     """The exact model alone (no mesh) at some temperatures of the range: the plays over the cycle
-    and where the least-play contacts lie (plain arrays)."""
+    and where the least-play contacts lie (plain arrays), and the onset of binding wherever the
+    least play crosses zero between two of them (solved here, beside the other tasks, rather than
+    after them all; a crossing between two tasks' temperatures is solved in the reduce step)."""
     t0 = time.perf_counter()
-    plays = exact_plays_or_unsolved(params, shim_mm, temperatures_C, angles_per_cycle=angles_per_cycle)
-    return {"plays": plays, "exact_s": time.perf_counter() - t0}
+    specs = gear_specs(params)
+    plays = exact_plays_or_unsolved(params, shim_mm, temperatures_C, specs=specs, angles_per_cycle=angles_per_cycle)
+    t1 = time.perf_counter()
+    onsets = crossings(params, shim_mm, plays, specs=specs, angles_per_cycle=angles_per_cycle)
+    return {"plays": plays, "onsets": onsets, "exact_s": t1 - t0, "onset_s": time.perf_counter() - t1}
 
 
 # --------------------------------------------------------------------------------------------
@@ -482,22 +488,33 @@ def make_plan(params, assembly: Assembly, bodies: Mapping[str, Body],
         pruned_triangles_mean=float(np.mean([len(m.faces) for m in meshes])), started=started,
         whole=whole_meshes(bodies, layout, {n: th for n, th in scales.items() if n in FAIL_STATES}))
     return SweepPlan(meshes=meshes, tasks=tasks, reduce=functools.partial(reduce_sweep, setup),
-                     weights=weights, unit="contact", order=run_order(tasks, range_tasks), first=setup.whole.build,
+                     weights=weights, unit="contact", order=run_order(tasks, range_tasks, weights),
+                     first=setup.whole.build,
                      options={"angles_per_cycle": angles_per_cycle, "shims_mm": shims, "range_shims": range_shims})
 
 
-def run_order(tasks: list[tuple], range_tasks: list[tuple[int, int]]) -> list[int]:
-    """The order to run the tasks in: mesh tasks grouped by the meshes they use (a worker taking a
-    run of them builds a few of the plan's BVHs, not all), in plan order within a group, then the
-    exact range tasks (no mesh; the calling process, which takes tasks from the back, starts on
-    them while the spawned workers start)."""
+def run_order(tasks: list[tuple], range_tasks: list[tuple[int, int]], weights: list[int]) -> list[int]:
+    """The order to run the tasks in: mesh tasks grouped by the meshes they use (a process taking a
+    run of them builds a few of the plan's BVHs, not all), in plan order within a group; the groups
+    in two halves of about equal weight with the exact range tasks (no mesh) between them. The
+    spawned workers take tasks from the front and the calling process from the back
+    (:class:`gearcheck.executor.ProcessExecutor`), so on two processes each builds the BVHs of its
+    own half only, and they meet in the range tasks, which take up the difference (the calling
+    process first builds the whole meshes' BVHs for the worst poses)."""
     ranged = {task for _, task in range_tasks}
 
     def meshes_of(n: int) -> tuple[str, ...]:
         return tuple(sorted(_mesh_names(tasks[n][1][2])))
 
-    mesh_tasks = sorted((n for n in range(len(tasks)) if n not in ranged), key=meshes_of)
-    return mesh_tasks + sorted(ranged)
+    groups: dict[tuple[str, ...], list[int]] = {}
+    for n in range(len(tasks)):
+        if n not in ranged:
+            groups.setdefault(meshes_of(n), []).append(n)
+    ordered = [groups[key] for key in sorted(groups)]
+    sizes = np.cumsum([0] + [sum(weights[n] for n in group) for group in ordered])
+    half = int(np.argmin(np.abs(sizes - sizes[-1] / 2.0)))
+    front, back = ordered[:half], ordered[half:]
+    return [n for group in front for n in group] + sorted(ranged) + [n for group in back for n in group]
 
 
 def _exact_contacts(layout: Layout, built: Mapping[str, np.ndarray], shims: list[float], shim_states: list[list[int]],

@@ -404,27 +404,41 @@ class RangeCheck:
 
 
 def range_check(params, shim_mm: float, *, grid: bool = True, specs: GearSpecs | None = None,
-                plays: ExactPlays | None = None, angles_per_cycle: int = ANGLES_PER_CYCLE) -> RangeCheck:
+                plays: ExactPlays | None = None, angles_per_cycle: int = ANGLES_PER_CYCLE,
+                solved: Mapping[tuple[float, float], float] | None = None) -> RangeCheck:
     """The exact model over the operating and storage ranges at one shim: on the full grid
     (:func:`temperature_grid`), or at the named temperatures only (``grid=False``: concavity, see
     the module docstring), or on given ``plays``; every zero crossing between neighbouring
-    temperatures solved on the exact model."""
+    temperatures solved on the exact model (those in ``solved`` already were: :func:`crossings`)."""
     specs = gear_specs(params) if specs is None else specs
     keys = key_temperatures(params)
     if plays is None:
         temps = temperature_grid(params) if grid else _unique(keys.values())
         plays = exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle)
+    onsets = crossings(params, shim_mm, plays, specs=specs, angles_per_cycle=angles_per_cycle, solved=solved)
+    return RangeCheck(shim_mm, plays.temperatures_C, plays.least_arcmin, keys, tuple(sorted(onsets.values())),
+                      specs.big.outer_pitch_diameter_mm / 2.0, grid, plays)
+
+
+def crossings(params, shim_mm: float, plays: ExactPlays, *, specs: GearSpecs | None = None,
+              angles_per_cycle: int = ANGLES_PER_CYCLE, solved: Mapping[tuple[float, float], float] | None = None
+              ) -> dict[tuple[float, float], float]:
+    """Every zero crossing of the least play between neighbouring temperatures of ``plays``,
+    solved on the exact model (:func:`onset`): (free °C, binding °C) → onset °C. ``solved``: the
+    crossings already solved (by the tasks that computed those temperatures), taken as they are."""
     temps, least = plays.temperatures_C, plays.least_arcmin
-    onsets = []
+    out: dict[tuple[float, float], float] = {}
     for i in range(len(temps) - 1):
         if not (np.isfinite(least[i]) and np.isfinite(least[i + 1])):
             continue
         if (least[i] > 0.0) != (least[i + 1] > 0.0):
             free, bind = (i, i + 1) if least[i] > 0.0 else (i + 1, i)
-            onsets.append(onset(params, shim_mm, float(temps[free]), float(temps[bind]), free_play=float(least[free]),
-                                binding_play=float(least[bind]), specs=specs, angles_per_cycle=angles_per_cycle))
-    return RangeCheck(shim_mm, temps, least, keys, tuple(sorted(onsets)), specs.big.outer_pitch_diameter_mm / 2.0,
-                      grid, plays)
+            key = (float(temps[free]), float(temps[bind]))
+            known = None if solved is None else solved.get(key)
+            out[key] = known if known is not None else onset(
+                params, shim_mm, key[0], key[1], free_play=float(least[free]), binding_play=float(least[bind]),
+                specs=specs, angles_per_cycle=angles_per_cycle)
+    return out
 
 
 # --------------------------------------------------------------------------------------------
