@@ -133,6 +133,34 @@ def test_weighted_chunks_even_out_the_work_where_heavy_tasks_follow_light_ones()
         assert a.take_first() == b.take_first()
 
 
+def _handoff(_state: None, i: int, marker: str) -> tuple[int, bool]:
+    """Task 2 (the calling process's: the last in line) waits for task 1 to have run elsewhere."""
+    import os
+    import time
+
+    if i == 1:
+        open(marker, "w").close()
+    saw = False
+    if i == 2:
+        deadline = time.monotonic() + 20.0
+        while not (saw := os.path.exists(marker)) and time.monotonic() < deadline:
+            time.sleep(0.01)
+    return os.getpid(), saw
+
+
+def test_a_worker_gets_its_next_task_while_this_process_runs_a_long_one(tmp_path):
+    """Templates side by side: this process checks the longest, the worker the others one after
+    the other. The worker's next task is sent when its last one ends, not when this process is
+    next between two tasks of its own (it once waited a whole differential check for it)."""
+    import os
+
+    marker = str(tmp_path / "task-1-ran")
+    out = ProcessExecutor(2).map(_handoff, [(i, marker) for i in range(3)])
+    (pid0, _), (pid1, _), (pid2, saw) = out
+    assert pid2 == os.getpid() and pid0 != pid2 and pid1 == pid0
+    assert saw  # task 1 ran in the worker while task 2 was still running here
+
+
 def _marked(_state: None, i: int) -> tuple[int, bool]:
     import os
 

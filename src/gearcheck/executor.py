@@ -16,6 +16,7 @@ from __future__ import annotations
 import bisect
 import contextlib
 import ctypes
+import functools
 import logging
 import math
 import multiprocessing as mp
@@ -196,36 +197,55 @@ class ProcessExecutor:
 
     @staticmethod
     def _run(pool: Any, fn, tasks: list, workers: int, setup, shared, progress, weights, first) -> list:
-        """The map on ``pool`` (``workers − 1`` spawned workers) and this process."""
+        """The map on ``pool`` (``workers − 1`` spawned workers) and this process. A worker's next
+        chunk is sent as soon as one of its chunks ends, from the pool's result thread, not only
+        when this process is between two tasks of its own: a task here may be long (a whole
+        template's check, side by side with the others), and a worker must not wait for it."""
         queue = _Chunks(len(tasks), workers, weights)
         out: list[Any] = [None] * len(tasks)
-        inflight: dict[int, Any] = {}
+        inflight: dict[int, Any] = {}  # chunk start → its result, until collected here
+        running: set[int] = set()  # chunk starts not yet ended
+        lock = threading.Lock()  # queue, inflight, running: this thread and the pool's result thread
 
         def finish(start: int, results: list) -> None:
             for i, result in enumerate(results, start):
                 out[i] = result
                 _advance(progress, weights, i)
 
-        def feed() -> None:  # two chunks in flight per spawned worker; one when few tasks are left
-            while queue and len(inflight) < (2 if len(queue) > workers else 1) * (workers - 1):
+        def feed() -> None:  # under the lock; two chunks running per worker, one when few tasks are left
+            while queue and len(running) < (2 if len(queue) > workers else 1) * (workers - 1):
                 start, end = queue.take_first()
-                inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]))
+                running.add(start)
+                done = functools.partial(ended, start)
+                inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]), callback=done,
+                                                   error_callback=done)
 
-        feed()
+        def ended(start: int, _result: Any) -> None:  # in the pool's result thread
+            with lock:
+                running.discard(start)
+                feed()
+
+        with lock:
+            feed()
         if first is not None:
             first()  # while the workers start
         state = setup(shared) if setup is not None else shared
-        while queue or inflight:
-            feed()
-            for start in [k for k, r in inflight.items() if r.ready()]:
-                finish(start, inflight.pop(start).get())
-            feed()
-            if queue:  # this process takes the last task in line, the workers the first chunks
-                start = queue.take_last()
-                finish(start, [fn(state, *tasks[start])])
-            elif inflight:
-                next(iter(inflight.values())).wait(0.05)
-        return out
+        while True:
+            with lock:
+                for start in [k for k, r in inflight.items() if r.ready()]:
+                    finish(start, inflight.pop(start).get())
+                feed()
+                # this process takes the last task in line, the workers the first chunks
+                mine = queue.take_last() if queue else None
+                pending = next(iter(inflight.values()), None)
+            if mine is not None:
+                result = fn(state, *tasks[mine])
+                with lock:
+                    finish(mine, [result])
+            elif pending is not None:
+                pending.wait(0.05)
+            else:
+                return out
 
 
 class _Chunks:
