@@ -161,6 +161,51 @@ def test_a_worker_gets_its_next_task_while_this_process_runs_a_long_one(tmp_path
     assert saw  # task 1 ran in the worker while task 2 was still running here
 
 
+def _slow_identity(_state: None, i: int) -> int:
+    import time
+
+    time.sleep(0.005)
+    return i
+
+
+def test_a_failure_to_send_from_the_result_thread_is_raised_here_not_lost():
+    """The next chunk is sent from the pool's result thread; if sending fails there (the pool no
+    longer running, say), the map raises it in the calling process instead of waiting forever."""
+    import threading
+
+    class Result:
+        def __init__(self):
+            self.event, self.value = threading.Event(), None
+
+        def ready(self):
+            return self.event.is_set()
+
+        def wait(self, timeout):
+            self.event.wait(timeout)
+
+        def get(self):
+            self.event.wait()
+            return self.value
+
+    class Pool:  # runs each chunk in a thread; refuses chunks sent from any thread but the main one
+        def apply_async(self, fn, args, callback, error_callback):
+            if threading.current_thread() is not threading.main_thread():
+                raise ValueError("Pool not running")
+            result = Result()
+
+            def run():
+                result.value = fn(*args)
+                callback(result.value)
+                result.event.set()
+
+            threading.Thread(target=run, daemon=True).start()
+            return result
+
+    tasks = [(i,) for i in range(400)]
+    with pytest.raises(ValueError, match="Pool not running"):
+        ProcessExecutor._run(Pool(), _slow_identity, tasks, 2, None, None, None, None, None)
+
+
 def _marked(_state: None, i: int) -> tuple[int, bool]:
     import os
 

@@ -220,32 +220,45 @@ class ProcessExecutor:
                 inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]), callback=done,
                                                    error_callback=done)
 
-        def ended(start: int, _result: Any) -> None:  # in the pool's result thread
+        stopped: list[bool] = []  # the map has ended (a result, an error): nothing more is sent
+        failed: list[BaseException] = []  # raised while sending from the result thread, raised here
+
+        def ended(start: int, _result: Any) -> None:  # in the pool's result thread: must not raise
             with lock:
                 running.discard(start)
-                feed()
+                if not stopped and not failed:
+                    try:
+                        feed()
+                    except BaseException as error:  # noqa: BLE001 - handed to the calling thread
+                        failed.append(error)
 
-        with lock:
-            feed()
-        if first is not None:
-            first()  # while the workers start
-        state = setup(shared) if setup is not None else shared
-        while True:
+        try:
             with lock:
-                for start in [k for k, r in inflight.items() if r.ready()]:
-                    finish(start, inflight.pop(start).get())
                 feed()
-                # this process takes the last task in line, the workers the first chunks
-                mine = queue.take_last() if queue else None
-                pending = next(iter(inflight.values()), None)
-            if mine is not None:
-                result = fn(state, *tasks[mine])
+            if first is not None:
+                first()  # while the workers start
+            state = setup(shared) if setup is not None else shared
+            while True:
                 with lock:
-                    finish(mine, [result])
-            elif pending is not None:
-                pending.wait(0.05)
-            else:
-                return out
+                    if failed:
+                        raise failed[0]
+                    for start in [k for k, r in inflight.items() if r.ready()]:
+                        finish(start, inflight.pop(start).get())
+                    feed()
+                    # this process takes the last task in line, the workers the first chunks
+                    mine = queue.take_last() if queue else None
+                    pending = next(iter(inflight.values()), None)
+                if mine is not None:
+                    result = fn(state, *tasks[mine])
+                    with lock:
+                        finish(mine, [result])
+                elif pending is not None:
+                    pending.wait(0.05)
+                else:
+                    return out
+        finally:
+            with lock:  # before the pool is stopped: a chunk ending now sends nothing to it
+                stopped.append(True)
 
 
 class _Chunks:
