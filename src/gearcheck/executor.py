@@ -266,7 +266,7 @@ class _Chunks:
     process one task at a time from the back (so each keeps to its own run of tasks and the
     meshes they use, and this process tops up the workers' queue after every task it runs).
     Guided sizes, in task weights (the plan's estimate of each task's work; 1 each without):
-    a chunk weighs at most 1/(8·processes) of all tasks (few round trips) and at most
+    a chunk weighs at most 1/(8·processes) of all the work (few round trips) and at most
     1/(3·processes) of what is left, so chunks shrink towards the end and no process waits long
     for another's last chunk, even where a few heavy tasks follow many light ones; a chunk holds
     at least one task. With no more tasks left than processes, a worker gets one only when it has

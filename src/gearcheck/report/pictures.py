@@ -18,6 +18,7 @@ fixed size, fixed fonts).
 
 from __future__ import annotations
 
+import functools
 import math
 import os
 import pickle
@@ -403,10 +404,11 @@ class _Stage:
         return bytes(memoryview(writer.GetResult()))
 
 
+@functools.lru_cache(maxsize=1)
 def _font_file() -> str:
     """DejaVu Sans as shipped with matplotlib (a dependency): the same glyphs on every machine.
     Found in matplotlib's package folder without importing it (its import costs the picture
-    process about 0.1 s for one path)."""
+    process about 0.1 s for one path); looked up once per process, not for every picture's text."""
     import importlib.util
 
     try:
@@ -486,7 +488,7 @@ def _child() -> int:
     import vtkmodules.vtkRenderingFreeType  # noqa: F401
     import vtkmodules.vtkRenderingOpenGL2  # noqa: F401
 
-    _font_file()
+    _font_file()  # looked up (once, cached) while the scene is on its way
     # the pictures go to the real stdout; anything VTK prints there goes to stderr instead
     out = os.fdopen(os.dup(1), "wb")
     sys.stdout.flush()
