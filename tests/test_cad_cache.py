@@ -11,6 +11,7 @@ import logging
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -31,39 +32,48 @@ def test_root_from_the_environment(tmp_path):
     assert cache.root({}) == Path.home() / ".cache" / "gearcheck"
 
 
+def _key(label: str) -> str:
+    """A cache key (64 hex digits) for a test's label."""
+    return cache.key_of(label)
+
+
 def test_store_load_and_tampering(tmp_path, caplog):
     files = {"a.bin": b"x" * 1000, "b.bin": b"y"}
-    assert cache.store(tmp_path, "k1", files)
-    assert not cache.store(tmp_path, "k1", {"a.bin": b"other"})  # published already: kept as it is
-    entry = cache.load(tmp_path, "k1")
-    assert entry is not None and entry.files == files and entry.key == "k1"
-    assert cache.load(tmp_path, "missing") is None
-    (tmp_path / "k1" / "a.bin").write_bytes(b"x" * 999)  # cut short
+    k1 = _key("k1")
+    assert cache.store(tmp_path, k1, files)
+    assert not cache.store(tmp_path, k1, {"a.bin": b"other"})  # published already: kept as it is
+    entry = cache.load(tmp_path, k1)
+    assert entry is not None and entry.files == files and entry.key == k1
+    assert cache.load(tmp_path, _key("missing")) is None
+    (tmp_path / k1 / "a.bin").write_bytes(b"x" * 999)  # cut short
     with caplog.at_level(logging.WARNING, logger="gearcheck"):
-        assert cache.load(tmp_path, "k1") is None
-    assert "unreadable" in caplog.text and not (tmp_path / "k1").exists()
-    assert cache.store(tmp_path, "k1", files) and cache.load(tmp_path, "k1").files == files
-    (tmp_path / "k1" / "a.bin").write_bytes(b"z" * 1000)  # edited, the same size: its SHA-256 tells
-    assert cache.load(tmp_path, "k1") is None and not (tmp_path / "k1").exists()
-    assert cache.store(tmp_path, "k1", files)
-    (tmp_path / "k1" / "b.bin").unlink()  # a file gone: the entry goes too, to be written again
-    assert cache.load(tmp_path, "k1") is None and not (tmp_path / "k1").exists()
-    assert cache.store(tmp_path, "k1", files)
+        assert cache.load(tmp_path, k1) is None
+    assert "unreadable" in caplog.text and not (tmp_path / k1).exists()
+    assert cache.store(tmp_path, k1, files) and cache.load(tmp_path, k1).files == files
+    (tmp_path / k1 / "a.bin").write_bytes(b"z" * 1000)  # edited, the same size: its SHA-256 tells
+    assert cache.load(tmp_path, k1) is None and not (tmp_path / k1).exists()
+    assert cache.store(tmp_path, k1, files)
+    (tmp_path / k1 / "b.bin").unlink()  # a file gone: the entry goes too, to be written again
+    assert cache.load(tmp_path, k1) is None and not (tmp_path / k1).exists()
+    assert cache.store(tmp_path, k1, files)
+    with pytest.raises(ValueError, match="not a CAD cache key"):
+        cache.load(tmp_path, "../k1")
 
 
 def test_eviction_keeps_the_most_recently_used(tmp_path):
-    for i, key in enumerate(("old", "mid", "new")):
+    old, mid, new = (_key(label) for label in ("old", "mid", "new"))
+    for i, key in enumerate((old, mid, new)):
         cache.store(tmp_path, key, {"f": bytes(1000)})
         os.utime(tmp_path / key / cache.INDEX, (1000.0 + i, 1000.0 + i))
-    assert cache.load(tmp_path, "old") is not None  # used now: the newest
-    stale = tmp_path / ".deadbeef-left"
-    stale.mkdir()
+    assert cache.load(tmp_path, old) is not None  # used now: the newest
+    stale = Path(tempfile.mkdtemp(prefix=f"{cache.STAGING}{'d' * 16}-", dir=tmp_path))
+    (stale / cache.MARK).write_bytes(cache.MARK_TEXT)
     os.utime(stale, (time.time() - 2 * cache.STALE_S,) * 2)
-    fresh = tmp_path / ".cafe-writing"
-    fresh.mkdir()
+    fresh = Path(tempfile.mkdtemp(prefix=f"{cache.STAGING}{'c' * 16}-", dir=tmp_path))
+    (fresh / cache.MARK).write_bytes(cache.MARK_TEXT)
     removed = cache.evict(tmp_path, max_bytes=2600)
-    assert sorted(removed) == ["mid"]  # "new" and "old" (about 1.3 kB each with the index) fit
-    assert sorted(p.name for p in tmp_path.iterdir()) == [".cafe-writing", "new", "old"]
+    assert removed == [mid]  # new and old (about 1.3 kB each with the index and the mark) fit
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([cache.TAG, fresh.name, new, old])
 
 
 def test_key_follows_the_geometry_not_the_sweep_settings(monkeypatch):
@@ -124,7 +134,9 @@ def test_recheck_from_the_cache_is_the_same_run(tmp_path):
                               str(tmp_path / label)], cwd=ROOT, env=env, capture_output=True, text=True,
                              timeout=600, check=False)
         assert out.returncode in (0, 1), out.stderr[-2000:]
-    assert len(list((tmp_path / "cache").iterdir())) == 3
+    assert sorted(p.name for p in (tmp_path / "cache").iterdir() if p.name != cache.TAG) == sorted(
+        p.name for p in (tmp_path / "cache").iterdir() if cache.KEY.fullmatch(p.name))
+    assert len(list((tmp_path / "cache").iterdir())) == 4  # three entries and the tag
     for folder in sorted(f for f in (tmp_path / "cold").iterdir() if f.is_dir()):
         again = tmp_path / "warm" / folder.name
         cold, warm = _files(folder), _files(again)
@@ -161,7 +173,7 @@ def test_an_entry_that_does_not_read_back_is_built_again(steering, tmp_path, cap
 
     design, built = steering
     first = pipeline.build(design, tmp_path / "a")
-    (entry,) = (tmp_path / "cache").iterdir()
+    (entry,) = (p for p in (tmp_path / "cache").iterdir() if p.name != cache.TAG)
     data = (entry / "cad.pickle").read_bytes()
     (entry / "cad.pickle").write_bytes(data[: len(data) // 2])
     with caplog.at_level(logging.WARNING, logger="gearcheck"):

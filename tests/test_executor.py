@@ -172,34 +172,19 @@ def test_a_failure_to_send_from_the_result_thread_is_raised_here_not_lost():
     """The next chunk is sent from the pool's result thread; if sending fails there (the pool no
     longer running, say), the map raises it in the calling process instead of waiting forever."""
     import threading
-
-    class Result:
-        def __init__(self):
-            self.event, self.value = threading.Event(), None
-
-        def ready(self):
-            return self.event.is_set()
-
-        def wait(self, timeout):
-            self.event.wait(timeout)
-
-        def get(self):
-            self.event.wait()
-            return self.value
+    from concurrent.futures import Future
 
     class Pool:  # runs each chunk in a thread; refuses chunks sent from any thread but the main one
-        def apply_async(self, fn, args, callback, error_callback):
+        def submit(self, fn, *args):
             if threading.current_thread() is not threading.main_thread():
                 raise ValueError("Pool not running")
-            result = Result()
+            future: Future = Future()
 
             def run():
-                result.value = fn(*args)
-                callback(result.value)
-                result.event.set()
+                future.set_result(fn(*args))
 
             threading.Thread(target=run, daemon=True).start()
-            return result
+            return future
 
     tasks = [(i,) for i in range(400)]
     with pytest.raises(ValueError, match="Pool not running"):
@@ -285,3 +270,96 @@ def test_the_shared_state_reaches_the_workers_through_a_file_removed_after_the_m
     with pytest.raises(ArithmeticError):
         ProcessExecutor(2).map(_fails_at, [(i,) for i in range(64)], shared=[1, 2, 3])
     assert left() == before
+
+
+# ------------------------------------------------------------------------------------------
+# Faults: a worker killed, a task no worker can load, more jobs than cores
+
+
+def _kill_self_at(_state: None, i: int, victim: int) -> int:
+    import os
+    import signal
+    import time
+
+    if i == victim and os.getpid() != int(os.environ["GEARCHECK_TEST_PARENT"]):
+        os.kill(os.getpid(), signal.SIGKILL)  # as the OOM killer does
+    time.sleep(0.01)
+    return i
+
+
+def test_a_worker_killed_ends_the_map_within_seconds_with_one_line(monkeypatch):
+    """Before: the pool replaced the killed worker and waited forever for its chunk's result
+    (a check made no progress in 300 s). Now the map stops at once with WorkerError."""
+    import os
+    import time
+
+    from gearcheck.executor import WorkerError
+
+    monkeypatch.setenv("GEARCHECK_TEST_PARENT", str(os.getpid()))
+    started = time.monotonic()
+    with pytest.raises(WorkerError, match=r"a worker process died \(killed by SIGKILL: out of memory\?\)"):
+        ProcessExecutor(2).map(_kill_self_at, [(i, 3) for i in range(200)])
+    assert time.monotonic() - started < 20
+
+
+def test_a_task_no_worker_can_load_fails_at_once_with_the_cure():
+    """A function the workers cannot import (defined in a notebook, ``python -c`` or stdin) ends
+    the map with one line naming it and the cure, instead of a pool waiting on dead workers."""
+    import time
+
+    from gearcheck.executor import WorkerError
+
+    namespace: dict = {}
+    exec("def local_task(state, i):\n    return i\n", namespace)  # noqa: S102 - a function no module holds
+    fn = namespace["local_task"]
+    fn.__module__ = "__main__"
+    started = time.monotonic()
+    with pytest.raises(WorkerError, match=r"cannot load local_task from the script or notebook.*jobs=1"):
+        ProcessExecutor(2).map(fn, [(i,) for i in range(50)])
+    assert time.monotonic() - started < 20
+
+
+def test_jobs_beyond_the_cores_are_lowered_to_them(caplog):
+    """Before: ``--jobs 100000`` started 144 processes (5.3 GB in 48 s)."""
+    with caplog.at_level("WARNING", logger="gearcheck"):
+        assert ProcessExecutor(100000).jobs == available_cores()
+        assert make_executor(100000).jobs == available_cores()
+    assert "--jobs 100000: more than the" in caplog.text
+    with pytest.raises(ValueError):
+        ProcessExecutor(0)
+
+
+def test_the_shared_state_file_has_no_name_a_killed_run_could_leave():
+    """Before: a SIGKILL during a sweep left gearcheck-shared-*.pickle (up to 15 MB) in /dev/shm
+    for good. On Linux the workers now read an anonymous memory file through /proc."""
+    import os
+
+    from gearcheck.executor import _shared_file
+
+    if not hasattr(os, "memfd_create"):
+        pytest.skip("no anonymous memory files here")
+    with _shared_file({"a": 1}) as path:
+        assert path is not None and path.startswith(f"/proc/{os.getpid()}/fd/")
+        import pickle
+
+        with open(path, "rb") as fh:
+            assert pickle.load(fh) == {"a": 1}
+    assert not os.path.exists(path)
+
+
+def test_a_script_read_from_stdin_is_one_line_naming_the_cause(tmp_path):
+    """Before: ``python - < script.py`` with workers failed with ``OutputError: …/<stdin>:
+    cannot write`` (a spawned worker cannot run ``<stdin>`` again), blaming the output folder."""
+    import subprocess
+    import sys
+
+    script = ("from gearcheck.executor import ProcessExecutor, WorkerError\n"
+              "import operator\n"
+              "try:\n"
+              "    ProcessExecutor(2).map(operator.add, [(i,) for i in range(8)], shared=1)\n"
+              "except WorkerError as exc:\n"
+              "    print(exc)\n")
+    out = subprocess.run([sys.executable, "-"], input=script, capture_output=True, text=True, timeout=60,
+                         cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert "cannot start from a script that is not a file (<stdin>" in out.stdout and "jobs=1" in out.stdout

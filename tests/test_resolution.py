@@ -86,7 +86,7 @@ def test_tol_help_names_each_mechanisms_default():
     mechanism when the help is shown): the values the build uses."""
     import re
 
-    from gearcheck.cli import build_parser
+    from gearcheck.arguments import build_parser
     from gearcheck.mechanism import all_mechanisms
 
     parser = build_parser()

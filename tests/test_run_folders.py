@@ -83,8 +83,8 @@ def test_a_second_run_into_the_same_folder_is_refused(tmp_path):
 def test_leftovers_of_a_killed_run_are_removed_by_the_next(tmp_path):
     target = tmp_path / "run"
     write_run(target, {"a.txt": "1"})
-    (tmp_path / ".run.staging-killed").mkdir()
-    (tmp_path / ".run.staging-killed" / "big.stl").write_text("half")
+    (tmp_path / ".run.staging-kil_led9").mkdir()
+    (tmp_path / ".run.staging-kil_led9" / "big.stl").write_text("half")
     (tmp_path / ".run.old-99999").mkdir()
     write_run(target, {"a.txt": "2"})
     assert strays(tmp_path, "run") == []

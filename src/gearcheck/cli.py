@@ -1,5 +1,6 @@
 """Command line: parse, call the pipeline, print. Exit codes: 0 ok, 1 a verdict failed, 2 bad
-input (or an output that cannot be written), 130 / 143 interrupted by SIGINT / SIGTERM.
+input (or an output that cannot be written), 3 an internal error (a worker process died, a bug:
+one line, the traceback under ``-v``), 130 / 143 interrupted by SIGINT / SIGTERM.
 
 The only module that prints. Everything it runs is the library's (:mod:`gearcheck.design`,
 :mod:`gearcheck.pipeline`); what it shows is made by :mod:`gearcheck.terminal` (tables and
@@ -36,199 +37,29 @@ def _on_signal(signum: int, _frame: object) -> None:
     raise Interrupted(signum)
 
 
-if "--multiprocessing-fork" not in sys.argv:  # not in a sweep worker (its executor sets its own)
+# Not in a spawned worker process: it re-imports the script that started its parent (this one, as
+# the console script) with the parent's sys.argv, and its executor sets handlers of its own; its
+# own command line (sys.orig_argv) says what it is.
+if "--multiprocessing-fork" not in sys.orig_argv:
     signal.signal(signal.SIGINT, _on_signal)
     signal.signal(signal.SIGTERM, _on_signal)
 
-import argparse  # noqa: E402  (after the handlers: an interrupt during start-up is one line too)
-import contextlib  # noqa: E402
-import json  # noqa: E402
-import logging  # noqa: E402
-import os  # noqa: E402
-from pathlib import Path  # noqa: E402
-from typing import TYPE_CHECKING, Any  # noqa: E402
+try:  # after the handlers: an interrupt during start-up is one line too
+    import contextlib
+    import json
+    import logging
+    import os
+    from pathlib import Path
+    from typing import TYPE_CHECKING, Any
 
-from gearcheck import __version__  # noqa: E402
+except Interrupted as _early:
+    sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(_early.signum).name}): nothing written\n")
+    raise SystemExit(128 + _early.signum) from None
 
 if TYPE_CHECKING:
     from gearcheck.design import Design
     from gearcheck.pipeline import Bar, CheckRun
     from gearcheck.terminal import Checked, Screen
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str):  # usage errors are bad input: exit 2, one line
-        self.exit(2, f"gearcheck: error: {message}\n")
-
-
-def _jobs(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--jobs = {text!r}: allowed a whole number ≥ 1") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"--jobs = {value}: allowed a whole number ≥ 1")
-    return value
-
-
-def _add_template_args(p: argparse.ArgumentParser) -> None:
-    p.add_argument("template", type=Path, help="TOML parameter file (see templates/)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                   help="override one template value, validated like the file (repeatable), "
-                        "e.g. --set shim.thickness_mm=0.15")
-
-
-def _add_jobs_arg(p: argparse.ArgumentParser, what: str) -> None:
-    p.add_argument("--jobs", "-j", type=_jobs, default=None, metavar="N",
-                   help=f"worker processes for {what} (default: every core; 1 runs in this process). "
-                        "Results are identical for any N.")
-
-
-def _add_open_arg(p: argparse.ArgumentParser, what: str) -> None:
-    p.add_argument("--open", action="store_true", help=f"open {what} in the web browser when done")
-
-
-def _add_cad_args(p: argparse.ArgumentParser, verb: str) -> None:
-    """TEMPLATE | --all, --set, --out, --tol, --jobs, --json, --open: shared by `build` and `check`."""
-    from gearcheck.terminal import TOL_HELP
-
-    p.add_argument("template", type=Path, nargs="?", help="TOML parameter file (omit with --all)")
-    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
-                   help="override one template value (repeatable)")
-    p.add_argument("--all", action="store_true",
-                   help=f"{verb} every template into OUT/NAME (those in --templates, else ./templates/, "
-                        "else the ones shipped with gearcheck)")
-    p.add_argument("--templates", type=Path, default=None, metavar="DIR",
-                   help="folder of templates for --all (default: ./templates/ if it holds any, else the shipped ones)")
-    p.add_argument("--out", type=Path, default=None,
-                   help="output folder (default out/NAME; with --all, the parent folder, default out)")
-    p.add_argument("--tol", type=float, default=None, metavar="MM", help=TOL_HELP)
-    _add_jobs_arg(p, "the sweep" if verb == "check" else "building several templates (--all)")
-    p.add_argument("--no-cache", action="store_true", help="build the solids and meshes anew, neither reading nor "
-                   "writing the CAD cache ($GEARCHECK_CACHE, default ~/.cache/gearcheck; GEARCHECK_CACHE=off: always)")
-    what = ("the verdicts, the key figures (paper / model / geometry, exact confirmation)" if verb == "check"
-            else "the parts (material, triangles, volume)")
-    p.add_argument("--json", action="store_true",
-                   help=f"print one JSON object on stdout and nothing else: mechanism, name, folder, {what}, the "
-                        "mesh, and every file written with its size (with --all: {\"runs\": [...]})")
-    _add_open_arg(p, "report.html" if verb == "check" else "the output folder")
-
-
-def build_parser() -> argparse.ArgumentParser:
-    from gearcheck.mechanism import names
-    from gearcheck.terminal import BUILD_EXAMPLES, CHECK_EXAMPLES, DESCRIPTION, HelpFormatter as _Formatter
-
-    parser = _Parser(prog="gearcheck", description=DESCRIPTION.format(mechanisms=", ".join(names())),
-                     formatter_class=_Formatter)
-    parser.add_argument("--version", action="version", version=f"gearcheck {__version__}")
-    parser.add_argument("--verbose", "-v", action="store_true", help="print diagnostics (timings, workers) to stderr")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-
-    calc = sub.add_parser(
-        "calc", formatter_class=_Formatter,
-        help="the paper's analytical model: design figures beside the paper's numbers",
-        description="Compute the mechanism's design figures from its template with the paper's "
-        "analytical model (reconstructed where the paper lost equations), and print them beside "
-        "the paper's printed values with the difference and the reason where they differ.",
-        epilog="Examples:\n  gearcheck calc templates/zhurong_differential.toml --set operating.cold_C=-130\n"
-               "  gearcheck calc templates/eod_track_drive.toml --json | jq .track.paper\n"
-               "  gearcheck calc templates/nose_wheel_steering.toml | less -S",
-    )
-    _add_template_args(calc)
-    calc.add_argument("--json", action="store_true",
-                      help="print one JSON object (nested by section) instead of a table")
-
-    build = sub.add_parser(
-        "build", formatter_class=_Formatter, epilog=BUILD_EXAMPLES,
-        help="build the CAD: STEP assembly, one STL per part, manifest.json",
-        description="Build the mechanism's parts with CadQuery from the template (exact involute "
-        "flanks), mesh each part with an absolute chordal tolerance, and write DIR/NAME.step "
-        "(named, placed parts), DIR/PART.stl, DIR/params.toml (the resolved parameters) and "
-        "DIR/manifest.json (materials, volumes, triangle counts, measured mesh error, file hashes). "
-        "Every file is written atomically.",
-    )
-    _add_cad_args(build, "build")
-
-    check = sub.add_parser(
-        "check", formatter_class=_Formatter, epilog=CHECK_EXAMPLES,
-        help="build, mesh and sweep the mechanism; write report.html, summary.json, sweep.csv",
-        description="Build the CAD (as `build`), sweep the assembly through its motion with "
-        "python-fcl on the meshes (warm and cold for the differential, a full engagement cycle "
-        "for the track drive, towing and power modes for the steering), confirm each sweep's "
-        "worst pose on the exact B-rep, and write DIR/report.html (verdicts, paper vs model vs "
-        "geometry, plots), DIR/summary.json (numbers) and DIR/sweep.csv (one row per pose) beside "
-        "the CAD. Each verdict is pass, warn or fail and names the evidence that decided it (exact "
-        "model, mesh sweep, exact B-rep). Exit 0 when no verdict fails (warnings included), 1 when "
-        "one fails, 2 on input no design can meet.",
-    )
-    _add_cad_args(check, "check")
-
-    demo = sub.add_parser("demo", formatter_class=_Formatter,
-                          help="every template in templates/: figures and CAD under --out (what `make demo` runs)",
-                          description="Check every template into OUT/NAME: the verdicts of each, and a pointer "
-                          "to its analytical figures (OUT/NAME/calc.txt and calc.json, as `gearcheck calc` prints "
-                          "them). Exit 1 if a verdict fails, after every template has run.",
-                          epilog="Examples:\n  gearcheck demo --open\n  gearcheck demo --no-cad --out /tmp/figures")
-    demo.add_argument("--out", type=Path, default=Path("out"), help="output folder (default: out)")
-    demo.add_argument("--templates", type=Path, default=None, metavar="DIR",
-                      help="folder of templates (default: ./templates/ if it holds any, else the shipped ones)")
-    demo.add_argument("--no-cad", action="store_true", help="analytical figures only, no CAD build")
-    _add_jobs_arg(demo, "the sweeps")
-    _add_open_arg(demo, "each report (the output folder with --no-cad)")
-
-    study = sub.add_parser(
-        "study", formatter_class=_Formatter,
-        help="Monte Carlo over tolerances, temperature and wear: probabilities of failure, sensitivities",
-        description="Run a study file: draw variants of its template from the distributions it declares "
-        "(seeded Sobol/LHS sequence, reproducible row for row), evaluate every variant on the analytical "
-        "model and the exact model (numpy, no mesh), re-check the worst with the full pipeline (CAD, "
-        "meshes, sweep, exact B-rep), and write DIR/results.parquet (one row per variant), DIR/summary.json "
-        "(distributions, each failure's probability with a 95 % Wilson interval, sensitivities) and "
-        "DIR/report.html — one transaction, like `check`. Shipped studies: `gearcheck templates` lists them; "
-        "pass a file name or its stem.",
-        epilog="Examples:\n  gearcheck study differential_tolerances --samples 256"
-        "\n  gearcheck study my_study.toml --scheduler tcp://10.0.0.5:8786\n  gearcheck study track_wear "
-        "--scheduler local-cluster --jobs 2",
-    )
-    study.add_argument("study", type=str, help="study file (TOML), or the name of a shipped study")
-    study.add_argument("--samples", type=_jobs, default=None, metavar="N", help="variants (default: the study's)")
-    study.add_argument("--seed", type=int, default=None, metavar="S", help="sequence seed (default: the study's)")
-    study.add_argument("--exact", type=int, default=None, metavar="N",
-                       help="variants evaluated on the exact model (default: the study's; -1 every variant)")
-    study.add_argument("--check-worst", type=int, default=None, metavar="K",
-                       help="worst variants re-checked on real geometry (default: the study's)")
-    study.add_argument("--scheduler", default=None, metavar="ADDRESS",
-                       help="run on a Dask cluster: tcp://HOST:PORT of an existing scheduler (its workers must "
-                            "have gearcheck installed), or local-cluster to start one here with --jobs workers "
-                            "(default: local processes, no set-up)")
-    study.add_argument("--out", type=Path, default=None, help="output folder (default out/study_NAME)")
-    _add_jobs_arg(study, "the variants")
-
-    templates = sub.add_parser("templates", formatter_class=_Formatter,
-                               help="list the templates shipped with gearcheck, or copy them to a folder",
-                               description="List the templates shipped with gearcheck (file, mechanism, what it "
-                               "models), or copy them into DIR to edit, with the JSON Schemas their first lines "
-                               "point to (DIR/schema/): `gearcheck templates --copy my_designs`.")
-    templates.add_argument("--copy", type=Path, default=None, metavar="DIR",
-                           help="copy the shipped templates (and their schemas) into DIR (created; an existing "
-                                "different file is not overwritten)")
-
-    schema = sub.add_parser(
-        "schema", formatter_class=_Formatter,
-        help="print the JSON Schema of a mechanism's template (completion and checks in TOML editors)",
-        description="Print the JSON Schema (draft 2020-12) of a mechanism's template, made from the model that "
-        "validates it: every section and key with its description, unit and allowed range, unknown keys "
-        "refused. TOML editors (taplo, VS Code's Even Better TOML) use it through a first line "
-        "`#:schema ./schema/MECHANISM.json`, as the shipped templates have (`gearcheck templates --copy DIR` "
-        "copies the schemas too). Rules across fields (e.g. an odd tooth count, ISO 606 limits) are checked "
-        "when the template is loaded.",
-        epilog="Examples:\n  gearcheck schema track > track.schema.json\n"
-               "  gearcheck schema templates/zhurong_differential.toml   (the schema of the template's mechanism)\n"
-               "  taplo check templates/eod_track_drive.toml   (an editor's checks, from the #:schema line)",
-    )
-    schema.add_argument("mechanism", metavar="MECHANISM",
-                        help=f"a mechanism ({', '.join(names())}) or a template file naming one")
-    return parser
-
 
 # ------------------------------------------------------------------------------------------
 # Progress and printing
@@ -319,7 +150,8 @@ def _templates_or_one(args) -> list[Design]:
     if args.no_cache:  # read by this process and inherited by the workers it spawns
         os.environ["GEARCHECK_CACHE"] = "off"
     if args.all == (args.template is not None):
-        raise ParamError(args.command, str(args.template), "give one TEMPLATE or --all, not both or neither")
+        given = "(none)" if args.template is None else f"{args.template} with --all"
+        raise ParamError("TEMPLATE", given, f"allowed one TEMPLATE or --all for {args.command}, not both or neither")
     if not args.all:
         return [load_template(args.template, args.overrides)]
     _, paths = find_templates(args.templates)
@@ -373,9 +205,17 @@ def _side_by_side(executor: Any, designs: list[Design], fn: Any, args_of: Any, v
     """``fn(None, *args_of(i))`` for every template, side by side (one's single-core stages overlap
     another's), in template order. The finest default mesh (the longest run) last in line: this
     process takes it at once, with every core for its sweep; the spawned workers the others."""
+    from gearcheck.output import remove_leftovers
+
     order = sorted(range(len(designs)), key=lambda i: -float(designs[i].impl.mesh_tol_mm))
-    with _display() as bars, bars(verb, len(order), "template") as bar:
-        done = executor.map(fn, [args_of(i) for i in order], progress=bar.update)
+    tasks = [args_of(i) for i in order]
+    try:
+        with _display() as bars, bars(verb, len(order), "template") as bar:
+            done = executor.map(fn, tasks, progress=bar.update)
+    except BaseException:  # the workers were stopped without a chance to clean up: their staging folders
+        for task in tasks:
+            remove_leftovers(task[1])
+        raise
     return [r for _, r in sorted(zip(order, done, strict=True), key=lambda x: x[0])]
 
 
@@ -499,7 +339,7 @@ def cmd_templates(args) -> int:
             print(f"{path.stem:32s} {'study':13s} {spec.title} (template {spec.template})")
         print(f"({len(studies)} studies; run one with `gearcheck study NAME`)")
         return 0
-    folder = ensure_out_dir(args.copy)
+    folder = ensure_out_dir(args.copy, "--copy")
     copies = [(p, folder / p.name) for p in shipped] + [(p, folder / SCHEMA_FOLDER / p.name) for p in schemas]
     for path, target in copies:
         if target.exists() and target.read_bytes() != path.read_bytes():
@@ -530,20 +370,27 @@ def cmd_schema(args) -> int:
 def cmd_study(args) -> int:
     """A study: headline figures on stdout, the files in --out."""
     from gearcheck.studies.core import study
-    from gearcheck.studies.spec import find_study
+    from gearcheck.studies.spec import FLAGS, check_scheduler, find_study, flag_value
 
+    given = {k: None if getattr(args, k) is None else flag_value(k, getattr(args, k)) for k in FLAGS}
+    check_scheduler(args.scheduler)
     path = find_study(args.study)
     out = args.out if args.out is not None else Path("out") / f"study_{path.stem}"
     with _display() as bars:
-        result = study(path, samples=args.samples, seed=args.seed, jobs=args.jobs, scheduler=args.scheduler,
-                       out=out, exact=args.exact, check_worst=args.check_worst, progress=bars)
+        result = study(path, samples=given["samples"], seed=given["seed"], jobs=args.jobs, scheduler=args.scheduler,
+                       out=out, exact=given["exact"], check_worst=given["check_worst"], progress=bars)
     s = result.summary
     print(f"{s['study']}: {s['valid']} valid variants of {s['samples']} ({s['rejected']} rejected), "
           f"exact model on {s['exact_variants']}")
     for name, f in s["failures"].items():
+        if not f["variants"]:  # its output's level ran on no valid variant (--exact 0)
+            print(f"  P({name}): not evaluated ({f['output']} on 0 variants): {f['label']}")
+            continue
         print(f"  P({name}) = {100 * f['probability']:.3g} % [{100 * f['ci95_low']:.3g}, {100 * f['ci95_high']:.3g}] "
               f"({f['failures']}/{f['variants']}): {f['label']}")
     for target, sens in s["sensitivity"].items():
+        if not sens["variants"]:
+            continue
         top = ", ".join(f"{k} ({sens['srrc'][k]:+.2f})" for k in sens["ranking"][:3])
         print(f"  {target}: most sensitive to {top}")
     for c in s["checks"]:
@@ -556,17 +403,26 @@ COMMANDS = {"calc": cmd_calc, "study": cmd_study, "build": cmd_build, "check": c
             "templates": cmd_templates, "schema": cmd_schema}
 
 
-def _error(text: str) -> int:
+def _one_line(exc: BaseException, limit: int = 300) -> str:
+    text = " ".join(str(exc).split()) or "(no message)"
+    return text if len(text) <= limit else text[: limit - 1] + "…"
+
+
+def _error(text: str, code: int = 2) -> int:
     print(f"gearcheck: error: {text}", file=sys.stderr)
-    return 2
+    return code
 
 
 def _interrupted(signum: int) -> int:
     """One line, exit 128 + signal: what the run folder holds now."""
     from gearcheck.output import RunFolder
 
-    where = RunFolder.abandoned
-    what = f"{where} unchanged" if where else "nothing written"
+    if RunFolder.written:  # the new run was swapped in before the interrupt took effect
+        what = f"{RunFolder.written} holds the new run"
+    elif RunFolder.abandoned:
+        what = f"{RunFolder.abandoned} unchanged"
+    else:
+        what = "nothing written"
     with contextlib.suppress(OSError):
         sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(signum).name}): {what}\n")
         sys.stderr.flush()
@@ -581,7 +437,17 @@ def _quiet_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
 
 
+def _late_signal(signum: int, _frame: object) -> None:
+    """After the command has ended (its output flushed): an interrupt while the interpreter
+    exits is still one line and exit 128 + signal, never a traceback."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_IGN)
+    raise SystemExit(_interrupted(signum))
+
+
 def main(argv: list[str] | None = None) -> int:
+    """The command line (``argv`` None: ``sys.argv``, as the console script calls it); the exit
+    code."""
     try:
         return _main(argv)
     except Interrupted as exc:
@@ -590,31 +456,53 @@ def main(argv: list[str] | None = None) -> int:
         if _received:  # an interrupt surfaced as another error (e.g. inside an extension's import)
             return _interrupted(_received[0])
         raise
+    finally:
+        if argv is None and signal.getsignal(signal.SIGINT) is _on_signal:
+            signal.signal(signal.SIGINT, _late_signal)
+            signal.signal(signal.SIGTERM, _late_signal)
 
 
 def _main(argv: list[str] | None) -> int:
     for stream in (sys.stdout, sys.stderr):  # a terminal that cannot show "α" gets "\u03b1", not a crash
         with contextlib.suppress(AttributeError, ValueError):
             stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
+    from gearcheck.arguments import build_parser
+
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[_StderrHandler()],
                         format="gearcheck: %(message)s")
-    from gearcheck.output import output_error
-    from gearcheck.params import ParamError
-
     try:
         code = COMMANDS[args.command](args)
         sys.stdout.flush()
         return code
-    except ParamError as exc:
+    except Exception as exc:  # noqa: BLE001 - every failure ends in one line (_failed)
+        return _failed(exc, args.verbose)
+
+
+def _failed(exc: Exception, verbose: bool) -> int:
+    """The one line and exit code of a command that raised: 2 for bad input or an output that
+    cannot be written, 3 for a worker that died or any other error of gearcheck's own (or a
+    plugin's; the traceback under -v)."""
+    from gearcheck.executor import WorkerError
+    from gearcheck.output import output_error
+    from gearcheck.params import ParamError
+
+    if isinstance(exc, ParamError):
         return _error(str(exc))
-    except OSError as exc:  # an output nobody could write: stdout closed or full, a path too long
+    if _received:  # an interrupt surfaced as another error (e.g. inside an extension's import)
+        return _interrupted(_received[0])
+    if isinstance(exc, WorkerError):  # a worker process died or could not load its task
+        logging.getLogger("gearcheck").info("worker failure", exc_info=exc)
+        return _error(str(exc), 3)
+    if isinstance(exc, OSError):  # an output nobody could write: stdout closed or full, a path too long
         if exc.filename is None:  # no file named: the write that failed was to stdout
             _quiet_stdout()
             return _error(str(output_error(exc, "<stdout>")))
         return _error(str(output_error(exc, verb="access")))
-
+    logging.getLogger("gearcheck").info("internal error", exc_info=exc)
+    where = "" if verbose else " (run with -v for the traceback)"
+    return _error(f"internal error: {type(exc).__name__}: {_one_line(exc)}{where}", 3)
 
 if __name__ == "__main__":
     raise SystemExit(main())

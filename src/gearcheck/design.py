@@ -7,6 +7,7 @@ nor FCL; ``build``/``check``/``assembly_cad`` import them when called.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -135,9 +136,15 @@ def _check_run_keys(data: dict, path: Path | None, source: str) -> None:
         raise ParamError("name", _stem(path), f"{NAME_RULE}; the file's name names the result unless the "
                          "template sets a top-level name = \"...\"", source)
     tol = data.get("mesh_tol_mm")
-    if tol is not None and (isinstance(tol, bool) or not isinstance(tol, (int, float))
-                            or not TOL_MIN_MM <= tol <= TOL_MAX_MM):
-        raise ParamError("mesh_tol_mm", tol, f"out of range: allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm", source)
+    allowed = f"allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm"
+    if tol is None:
+        return
+    if isinstance(tol, bool) or not isinstance(tol, (int, float)):
+        raise ParamError("mesh_tol_mm", tol, f"wrong type: input should be a number; {allowed}", source)
+    if not math.isfinite(tol):
+        raise ParamError("mesh_tol_mm", tol, f"must be a finite number ({allowed})", source)
+    if not TOL_MIN_MM <= tol <= TOL_MAX_MM:
+        raise ParamError("mesh_tol_mm", tol, f"out of range: {allowed}", source)
 
 
 def from_data(data: dict, path: Path | None = None) -> Design:

@@ -29,6 +29,8 @@ import threading
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol
 
+from gearcheck.interrupts import DeferredSignals
+
 log = logging.getLogger("gearcheck")
 
 Progress = Callable[[int], None]
@@ -78,6 +80,11 @@ class SerialExecutor:
 _worker_state: Any = None
 
 
+class WorkerError(RuntimeError):
+    """A worker process died (killed, out of memory) or could not load its task: the map ends
+    at once with this one line instead of waiting for a result that will never come."""
+
+
 def _quiet_worker() -> None:
     """A worker leaves interrupts to its parent (which stops the pool) and dies with it: SIGINT
     ignored, SIGTERM the default (a silent exit), and on Linux a SIGKILL when the parent dies,
@@ -92,27 +99,79 @@ def _quiet_worker() -> None:
         os._exit(0)
 
 
-def _init_worker(setup, shared_file: str | None) -> None:
+def _init_worker(setup_ref: tuple[str, str] | None, shared_file: str | None) -> None:
     global _worker_state  # noqa: PLW0603 - one state per worker process, made once
     _quiet_worker()
     shared = None
     if shared_file is not None:
         with open(shared_file, "rb") as fh:
             shared = pickle.load(fh)
+    setup = _resolve(setup_ref) if setup_ref is not None else None
     _worker_state = setup(shared) if setup is not None else shared
+
+
+def _reference(fn: Callable[..., Any]) -> tuple[str, str]:
+    """A module-level function by name, (module, qualified name): resolved in the worker by
+    :func:`_resolve`, which says in one line why when it cannot be."""
+    return getattr(fn, "__module__", None) or "?", getattr(fn, "__qualname__", None) or repr(fn)
+
+
+def _resolve(ref: tuple[str, str]) -> Callable[..., Any]:
+    import importlib
+
+    module, name = ref
+    try:
+        found: Any = importlib.import_module("__mp_main__" if module == "__main__" else module)
+        for part in name.split("."):
+            found = getattr(found, part)
+    except Exception as exc:  # noqa: BLE001 - any failure to find it is the same one line
+        where = "the script or notebook being run" if module == "__main__" else f"module {module}"
+        raise WorkerError(f"a worker process cannot load {name} from {where} ({type(exc).__name__}): define "
+                          "it (and the mechanism) in an importable module, or run with jobs=1") from None
+    return found
+
+
+def _check_main_importable() -> None:
+    """A spawned worker first runs the script its parent was started from (as ``__mp_main__``);
+    a script read from standard input (``python - < script.py``) or any other file that is not
+    there has nothing to run, and every worker would die starting. Said in one line instead."""
+    main = sys.modules.get("__main__")
+    path = getattr(main, "__file__", None)
+    if path is None or getattr(getattr(main, "__spec__", None), "name", None) is not None:
+        return  # an interactive session or notebook (nothing to run), or a module run with -m
+    if not os.path.isfile(path):
+        raise WorkerError(f"worker processes cannot start from a script that is not a file ({path}: a script read "
+                          "from standard input?): save it to a file and run that, or run with jobs=1")
+
+
+def _run_chunk(fn_ref: tuple[str, str], chunk: list[tuple]) -> list:
+    fn = _resolve(fn_ref)
+    return [fn(_worker_state, *args) for args in chunk]
 
 
 @contextlib.contextmanager
 def _shared_file(shared: Any) -> Iterator[str | None]:
-    """``shared`` pickled once into a file the spawned workers read as they start (removed on
-    leaving). Passed in the workers' start-up arguments instead, tens of megabytes of meshes would
-    go down a pipe the calling process must wait on until each worker has started and read it
-    (about 0.2 s idle, before it can do any work of its own)."""
+    """``shared`` pickled once into a file the spawned workers read as they start. Passed in the
+    workers' start-up arguments instead, tens of megabytes of meshes would go down a pipe the
+    calling process must wait on until each worker has started and read it (about 0.2 s idle,
+    before it can do any work of its own).
+
+    On Linux the file has no name: an anonymous memory file (``memfd``) the workers open through
+    ``/proc/PID/fd/N`` while this process lives, so nothing is left behind whatever kills the
+    run (a SIGKILL included). Elsewhere, a temporary file removed on leaving."""
     if shared is None:
         yield None
         return
-    folder = "/dev/shm" if os.path.isdir("/dev/shm") and os.access("/dev/shm", os.W_OK) else None
-    fd, path = tempfile.mkstemp(prefix="gearcheck-shared-", suffix=".pickle", dir=folder)
+    fd = _anonymous_file()
+    if fd is not None:
+        try:
+            with os.fdopen(os.dup(fd), "wb") as fh:
+                pickle.dump(shared, fh, protocol=pickle.HIGHEST_PROTOCOL)
+            yield f"/proc/{os.getpid()}/fd/{fd}"
+        finally:
+            os.close(fd)
+        return
+    fd, path = tempfile.mkstemp(prefix="gearcheck-shared-", suffix=".pickle")
     try:
         with os.fdopen(fd, "wb") as fh:
             pickle.dump(shared, fh, protocol=pickle.HIGHEST_PROTOCOL)
@@ -122,22 +181,27 @@ def _shared_file(shared: Any) -> Iterator[str | None]:
             os.unlink(path)
 
 
-class _Spawning:
+def _anonymous_file() -> int | None:
+    """A memory file with no name that workers can open by ``/proc/PID/fd/N``, or None."""
+    if not hasattr(os, "memfd_create") or not os.path.isdir(f"/proc/{os.getpid()}/fd"):
+        return None
+    try:
+        return os.memfd_create("gearcheck-shared", os.MFD_CLOEXEC)  # workers open it by path, not inherit it
+    except OSError:
+        return None
+
+
+class _Spawning(DeferredSignals):
     """While workers are spawned: SIGINT blocked in this thread, so the children inherit it
     blocked (a Ctrl-C in the terminal — sent to the whole process group — reaches only the
     parent, which stops the pool); and SIGINT / SIGTERM that reach the process meanwhile (other
     threads, e.g. the CAD kernel's, do not block them) are only recorded, then raised again
-    once the pool exists and can be stopped cleanly. No-op outside the main thread of the main
-    process (signals are not ours to change there)."""
+    once the pool exists and can be stopped cleanly (:meth:`deliver`). No-op outside the main
+    thread of the main process (signals are not ours to change there)."""
 
     def __init__(self) -> None:
-        self.active = mp.parent_process() is None and threading.current_thread() is threading.main_thread()
-        self.pending: list[int] = []
-        self._handlers: dict[int, Any] = {}
+        super().__init__()
         self._mask: Any = None
-
-    def _record(self, signum: int, _frame: object) -> None:
-        self.pending.append(signum)
 
     def __enter__(self) -> _Spawning:
         if self.active:
@@ -146,119 +210,195 @@ class _Spawning:
             quiet = "ignore::UserWarning:multiprocessing.resource_tracker"
             if quiet not in sys.warnoptions:
                 sys.warnoptions.append(quiet)
-            self._handlers = {s: signal.signal(s, self._record) for s in (signal.SIGINT, signal.SIGTERM)}
+            super().__enter__()
             self._mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, *exc: object) -> None:  # the signals are delivered later, once the pool can stop
         if self.active:
-            for s, handler in self._handlers.items():
-                signal.signal(s, handler if handler is not None else signal.SIG_DFL)
+            self.restore()
             signal.pthread_sigmask(signal.SIG_SETMASK, self._mask)
 
-    def deliver(self) -> None:
-        """Raise the signals recorded while spawning (handled by the restored handlers)."""
-        for s in dict.fromkeys(self.pending):
-            signal.raise_signal(s)
+
+def _stop(pool: Any) -> None:
+    """Stop a process pool now: its workers killed (their tasks are abandoned), nothing waited
+    for that may never come."""
+    processes = list(getattr(pool, "_processes", {}).values())
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            process.kill()
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:  # gone, with the locks and files they held, before the caller cleans up
+        with contextlib.suppress(OSError, ValueError, AttributeError, AssertionError):
+            process.join(5)
 
 
-def _run_chunk(fn: Callable[..., Any], chunk: list[tuple]) -> list:
-    return [fn(_worker_state, *args) for args in chunk]
+def _broken(processes: list[Any]) -> WorkerError:
+    """The one line for a pool whose worker died, with how it died where that can be read (the
+    pool stops the other workers with SIGTERM once one has died)."""
+    codes = []
+    for process in processes:
+        with contextlib.suppress(OSError, ValueError, AttributeError, AssertionError):
+            process.join(1.0)
+            if process.exitcode not in (None, 0):
+                codes.append(process.exitcode)
+    how = ""
+    if -signal.SIGKILL in codes:
+        how = " (killed by SIGKILL: out of memory?)"
+    elif codes:
+        code = next((c for c in codes if c != -signal.SIGTERM), codes[0])
+        with contextlib.suppress(ValueError):
+            how = f" (killed by {signal.Signals(-code).name})" if code < 0 else f" (exit code {code})"
+    return WorkerError(f"a worker process died{how}: the run is stopped; run again with fewer --jobs, a coarser "
+                       "--tol, or --jobs 1 to run in this process")
 
 
 class ProcessExecutor:
-    """``jobs`` processes (default: every core this process may use): this one and ``jobs − 1``
-    spawned workers, all taking tasks from one queue (:class:`_Chunks`).
+    """``jobs`` processes (default: every core this process may use, and never more): this one
+    and ``jobs − 1`` spawned workers, all taking tasks from one queue (:class:`_Chunks`).
 
     This process works too: it would only wait otherwise, and it does its ``first`` work and its
     first tasks while the workers start, so two processes do close to twice the work of one — the
     spawned workers' start-up (interpreter, imports, their own state) is the only cost that does
-    not shrink with more processes, and this process hides its share of it."""
+    not shrink with more processes, and this process hides its share of it.
+
+    A worker that dies (killed by a signal, out of memory) or cannot load its task ends the map
+    at once with a :class:`WorkerError` (the pool is stopped; no result is waited for that
+    cannot come)."""
 
     def __init__(self, jobs: int | None = None):
-        self.jobs = available_cores() if jobs is None else int(jobs)
-        if self.jobs < 1:
-            raise ValueError(f"jobs must be at least 1, got {self.jobs}")
+        self.jobs = capped_jobs(jobs)
 
     def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None, first=None) -> list:
+        from concurrent.futures import ProcessPoolExecutor
+
         tasks = list(tasks)
         workers = min(self.jobs, len(tasks))
         if workers <= 1:
             return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights,
                                         first=first)
         log.debug("running %d tasks on %d processes (this one and %d spawned)", len(tasks), workers, workers - 1)
+        _check_main_importable()
         ctx = mp.get_context("spawn")
+        fn_ref = _reference(fn)
         with _shared_file(shared) as shared_file:
             with _Spawning() as spawning:
-                pool = ctx.Pool(workers - 1, initializer=_init_worker, initargs=(setup, shared_file))
-            with pool:  # leaving the block (an error, an interrupt) terminates the workers
+                pool = ProcessPoolExecutor(workers - 1, mp_context=ctx, initializer=_init_worker,
+                                           initargs=(_reference(setup) if setup is not None else None, shared_file))
+                run = _Run(pool, fn, fn_ref, tasks, workers, progress, weights)
+                run.feed_first()  # the workers are spawned as their first chunks are sent
+            try:
                 spawning.deliver()
-                return self._run(pool, fn, tasks, workers, setup, shared, progress, weights, first)
+                out = run.finish(setup, shared, first)
+            except BaseException:
+                _stop(pool)
+                raise
+            pool.shutdown(wait=True)
+            return out
 
     @staticmethod
     def _run(pool: Any, fn, tasks: list, workers: int, setup, shared, progress, weights, first) -> list:
-        """The map on ``pool`` (``workers − 1`` spawned workers) and this process. A worker's next
-        chunk is sent as soon as one of its chunks ends, from the pool's result thread, not only
-        when this process is between two tasks of its own: a task here may be long (a whole
-        template's check, side by side with the others), and a worker must not wait for it."""
-        queue = _Chunks(len(tasks), workers, weights)
-        out: list[Any] = [None] * len(tasks)
-        inflight: dict[int, Any] = {}  # chunk start → its result, until collected here
-        running: set[int] = set()  # chunk starts not yet ended
-        lock = threading.Lock()  # queue, inflight, running: this thread and the pool's result thread
+        """The map on ``pool`` (an executor of ``workers − 1`` processes, with ``submit``) and this
+        process."""
+        run = _Run(pool, fn, _reference(fn), tasks, workers, progress, weights)
+        run.feed_first()
+        return run.finish(setup, shared, first)
 
-        def finish(start: int, results: list) -> None:
-            for i, result in enumerate(results, start):
-                out[i] = result
-                _advance(progress, weights, i)
 
-        def feed() -> None:  # under the lock; two chunks running per worker, one when few tasks are left
-            while queue and len(running) < (2 if len(queue) > workers else 1) * (workers - 1):
-                start, end = queue.take_first()
-                running.add(start)
-                done = functools.partial(ended, start)
-                inflight[start] = pool.apply_async(_run_chunk, (fn, tasks[start:end]), callback=done,
-                                                   error_callback=done)
+class _Run:
+    """One map on a pool and this process. A worker's next chunk is sent as soon as one of its
+    chunks ends, from the pool's result thread, not only when this process is between two tasks
+    of its own: a task here may be long (a whole template's check, side by side with the
+    others), and a worker must not wait for it."""
 
-        stopped: list[bool] = []  # the map has ended (a result, an error): nothing more is sent
-        failed: list[BaseException] = []  # raised while sending from the result thread, raised here
+    def __init__(self, pool: Any, fn: Callable[..., Any], fn_ref: tuple[str, str], tasks: list, workers: int,
+                 progress: Progress | None, weights: Sequence[int] | None):
+        self.pool, self.fn, self.fn_ref, self.tasks, self.workers = pool, fn, fn_ref, tasks, workers
+        self.progress, self.weights = progress, weights
+        self.queue = _Chunks(len(tasks), workers, weights)
+        self.out: list[Any] = [None] * len(tasks)
+        self.inflight: dict[int, Any] = {}  # chunk start → its future, until collected here
+        self.running: set[int] = set()  # chunk starts not yet ended
+        self.lock = threading.Lock()  # all of the above: this thread and the pool's result thread
+        self.stopped = False  # the map has ended (a result, an error): nothing more is sent
+        self.failed: list[BaseException] = []  # raised while sending from the result thread, raised here
+        self.processes: list[Any] = []  # the pool's worker processes
 
-        def ended(start: int, _result: Any) -> None:  # in the pool's result thread: must not raise
-            with lock:
-                running.discard(start)
-                if not stopped and not failed:
-                    try:
-                        feed()
-                    except BaseException as error:  # noqa: BLE001 - handed to the calling thread
-                        failed.append(error)
+    def _collect(self, start: int, results: list) -> None:
+        for i, result in enumerate(results, start):
+            self.out[i] = result
+            _advance(self.progress, self.weights, i)
+
+    def _feed(self) -> None:  # under the lock; two chunks running per worker, one when few tasks are left
+        queue, workers = self.queue, self.workers
+        while queue and len(self.running) < (2 if len(queue) > workers else 1) * (workers - 1):
+            start, end = queue.take_first()
+            self.running.add(start)
+            future = self.pool.submit(_run_chunk, self.fn_ref, self.tasks[start:end])
+            self.inflight[start] = future
+            future.add_done_callback(functools.partial(self._ended, start))
+
+    def _ended(self, start: int, _future: Any) -> None:  # in the pool's result thread: must not raise
+        with self.lock:
+            self.running.discard(start)
+            if not self.stopped and not self.failed:
+                try:
+                    self._feed()
+                except BaseException as error:  # noqa: BLE001 - handed to the calling thread
+                    self.failed.append(error)
+
+    def feed_first(self) -> None:
+        """The first chunks sent: the pool spawns its workers as they are (one per chunk)."""
+        with self.lock:
+            self._feed()
+        self.processes = list(getattr(self.pool, "_processes", {}).values())  # to say how one died
+
+    def finish(self, setup: Callable[[Any], Any] | None, shared: Any, first: Callable[[], Any] | None) -> list:
+        from concurrent.futures import FIRST_COMPLETED, wait
+        from concurrent.futures.process import BrokenProcessPool
 
         try:
-            with lock:
-                feed()
             if first is not None:
                 first()  # while the workers start
             state = setup(shared) if setup is not None else shared
             while True:
-                with lock:
-                    if failed:
-                        raise failed[0]
-                    for start in [k for k, r in inflight.items() if r.ready()]:
-                        finish(start, inflight.pop(start).get())
-                    feed()
+                with self.lock:
+                    if self.failed:
+                        raise self.failed[0]
+                    for start in [k for k, f in self.inflight.items() if f.done()]:
+                        self._collect(start, self.inflight.pop(start).result())
+                    self._feed()
                     # this process takes the last task in line, the workers the first chunks
-                    mine = queue.take_last() if queue else None
-                    pending = next(iter(inflight.values()), None)
+                    mine = self.queue.take_last() if self.queue else None
+                    pending = list(self.inflight.values())
                 if mine is not None:
-                    result = fn(state, *tasks[mine])
-                    with lock:
-                        finish(mine, [result])
-                elif pending is not None:
-                    pending.wait(0.05)
+                    result = self.fn(state, *self.tasks[mine])
+                    with self.lock:
+                        self._collect(mine, [result])
+                elif pending:
+                    wait(pending, timeout=0.05, return_when=FIRST_COMPLETED)
                 else:
-                    return out
+                    return self.out
+        except BrokenProcessPool:
+            raise _broken(self.processes) from None
         finally:
-            with lock:  # before the pool is stopped: a chunk ending now sends nothing to it
-                stopped.append(True)
+            with self.lock:  # before the pool is stopped: a chunk ending now sends nothing to it
+                self.stopped = True
+
+
+def capped_jobs(jobs: int | None) -> int:
+    """``--jobs``: at least 1, and at most the cores this process may use (more processes than
+    cores only add start-up time and memory: a larger value is lowered, with a note)."""
+    cores = available_cores()
+    if jobs is None:
+        return cores
+    if int(jobs) < 1:
+        raise ValueError(f"jobs must be at least 1, got {jobs}")
+    if int(jobs) > cores:
+        log.warning("--jobs %d: more than the %d core%s this process may use; running %d", jobs, cores,
+                    "" if cores == 1 else "s", cores)
+        return cores
+    return int(jobs)
 
 
 class _Chunks:
@@ -318,22 +458,66 @@ class DaskExecutor:
     (``"local-cluster"``). Workers import gearcheck from their own environment (it must be
     installed there, the same version); tasks travel as module-level functions and plain data.
     Results come back in task order, like every executor. Use as a context manager: a cluster
-    started here is shut down on leaving."""
+    started here is shut down on leaving.
 
-    def __init__(self, scheduler: str, jobs: int | None = None):
+    Quiet: the log records of distributed (and of tornado and bokeh, which it runs on) reach no
+    handler while the executor is open unless gearcheck's own diagnostics are on (``-v``). A
+    cluster started here has no dashboard: its scheduler's HTTP server, which it always starts
+    (on port 8787 by default), listens on a random loopback port and serves nothing. An
+    interrupt while it starts takes effect once it can be shut down (no half-started cluster
+    left to exit handlers). ``timeout``: seconds an existing scheduler may take to answer
+    (OSError then)."""
+
+    LOGGERS = ("distributed", "tornado", "bokeh")
+
+    def __init__(self, scheduler: str, jobs: int | None = None, timeout: float = 20.0):
         from distributed import Client, LocalCluster
 
-        self._cluster = None
-        if scheduler == "local-cluster":
-            n = available_cores() if jobs is None else int(jobs)
-            if n < 1:
-                raise ValueError(f"jobs must be at least 1, got {n}")
-            self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                                         dashboard_address=None, silence_logs=logging.ERROR)
-            self.client = Client(self._cluster)
-        else:
-            self.client = Client(scheduler, timeout="20s")
-        self.jobs = max(1, sum(w.get("nthreads", 1) for w in self.client.scheduler_info()["workers"].values()))
+        self._cluster: Any = None
+        self.client: Any = None
+        self._levels = self._quiet_logs()
+        starting = _Spawning()
+        try:
+            if scheduler == "local-cluster":
+                with starting:
+                    self._cluster = self._local_cluster(LocalCluster, jobs)
+                    self.client = Client(self._cluster)
+                starting.deliver()
+            else:  # an interrupt while connecting acts at once (the wait may be long)
+                self.client = Client(scheduler, timeout=f"{timeout}s")
+            workers = self.client.scheduler_info()["workers"].values()
+            self.jobs = max(1, sum(w.get("nthreads", 1) for w in workers))
+        except BaseException:
+            self.close()
+            starting.deliver()  # an interrupt that came meanwhile (and may have failed the start) wins
+            raise
+
+    @staticmethod
+    def _local_cluster(cluster_class: Any, jobs: int | None) -> Any:
+        import dask
+
+        n = available_cores() if jobs is None else int(jobs)
+        if n < 1:
+            raise ValueError(f"jobs must be at least 1, got {n}")
+        # worker processes: their own log handlers, at this level
+        quiet = logging.WARNING if log.isEnabledFor(logging.INFO) else logging.CRITICAL + 1
+        # the workers take the configuration as it is now (no HTTP routes: nothing to serve)
+        with dask.config.set({"distributed.scheduler.http.routes": [], "distributed.worker.http.routes": []}):
+            return cluster_class(n_workers=n, threads_per_worker=1, processes=True, dashboard_address="127.0.0.1:0",
+                                 scheduler_kwargs={"dashboard": False}, silence_logs=quiet)
+
+    @classmethod
+    def _quiet_logs(cls) -> dict[str, int]:
+        """Without -v: every logger of :attr:`LOGGERS` (and below) above CRITICAL; their levels
+        before, to restore (nothing changed with -v)."""
+        if log.isEnabledFor(logging.INFO):
+            return {}
+        names = [n for n in list(logging.root.manager.loggerDict)
+                 if any(n == top or n.startswith(f"{top}.") for top in cls.LOGGERS)]
+        levels = {n: logging.getLogger(n).level for n in {*cls.LOGGERS, *names}}
+        for n in levels:
+            logging.getLogger(n).setLevel(logging.CRITICAL + 1)
+        return levels
 
     def __enter__(self) -> DaskExecutor:
         return self
@@ -342,9 +526,16 @@ class DaskExecutor:
         self.close()
 
     def close(self) -> None:
-        self.client.close()
-        if self._cluster is not None:
-            self._cluster.close()
+        try:
+            if self.client is not None:
+                self.client.close()
+            if self._cluster is not None:
+                self._cluster.close()
+        finally:
+            self.client = self._cluster = None
+            levels, self._levels = self._levels, {}
+            for n, level in levels.items():
+                logging.getLogger(n).setLevel(level)
 
     def map(self, fn, tasks, *, setup=None, shared=None, progress=None, weights=None, first=None) -> list:
         import uuid
@@ -369,9 +560,9 @@ class DaskExecutor:
 
 
 def make_executor(jobs: int | None = None) -> Executor:
-    """``--jobs N``: serial in this process at 1, a local process pool above (None: every core)."""
-    if jobs is not None and jobs < 1:
-        raise ValueError(f"jobs must be at least 1, got {jobs}")
+    """``--jobs N``: serial in this process at 1, a local process pool above (None: every core;
+    never more processes than cores)."""
+    jobs = capped_jobs(jobs)
     if jobs == 1:
         return SerialExecutor()
     return ProcessExecutor(jobs)

@@ -21,12 +21,14 @@ import errno
 import fcntl
 import logging
 import os
+import re
 import shutil
 import tempfile
-from pathlib import Path
 from collections.abc import Callable
+from pathlib import Path
 from types import TracebackType
 
+from gearcheck.interrupts import DeferredSignals
 from gearcheck.params import ParamError
 
 log = logging.getLogger("gearcheck")
@@ -36,6 +38,10 @@ RUN_MARKER = ".gearcheck-run"
 _STAGING = ".staging-"
 _OLD = ".old-"
 _LOCK = ".lock"
+# the longest hidden name a run makes beside the target: "." NAME ".staging-" and mkdtemp's 8
+# characters; a file name holds at most 255 bytes
+_HIDDEN_EXTRA = 1 + len(_STAGING) + 8
+NAME_MAX = 255
 
 
 class OutputError(ParamError):
@@ -56,44 +62,62 @@ def output_error(exc: OSError, path: str | os.PathLike | None = None, verb: str 
 def check_out_target(folder: Path) -> None:
     """Before any work: ``--out`` names a folder that a run can be swapped into — an existing
     writable folder, or a new one under a parent that can be created and written. Nothing is
-    created but missing parents."""
+    created but missing parents. A symbolic link is followed: the run replaces the folder it
+    points to, and the link stays."""
     folder = Path(folder)
     check_folder_name(folder)
+    real = resolved_target(folder)
     try:
-        if folder.exists():
-            ensure_out_dir(folder)  # a folder: writable? (probes with a temporary file, leaves nothing)
+        if real.exists():
+            ensure_out_dir(real)  # a folder: writable? (probes with a temporary file, leaves nothing)
         else:
-            ensure_out_dir(folder.absolute().parent)
+            ensure_out_dir(real.parent)
     except ParamError as exc:
         raise ParamError("--out", str(folder), exc.allowed) from None
 
 
-def check_folder_name(folder: Path) -> None:
-    """``--out`` names a folder: not empty, not a root, '.' or '..'."""
+def resolved_target(folder: Path) -> Path:
+    """The absolute folder a run into ``folder`` replaces: a symbolic link's target (followed
+    through every link, as the kernel does), else ``folder`` itself."""
+    folder = Path(folder).absolute()
+    return Path(os.path.realpath(folder)) if folder.is_symlink() else folder
+
+
+def check_folder_name(folder: Path, flag: str = "--out") -> None:
+    """``--out`` names a folder: not empty, not a root, '.' or '..', and short enough that the
+    hidden staging folder beside it has a legal name."""
     text = str(folder)
     if text in ("", "."):
-        raise ParamError("--out", text, "allowed a folder path (an empty path would write into the working folder)")
+        raise ParamError(flag, text, "allowed a folder path (an empty path would write into the working folder)")
     if folder.name in ("", ".", ".."):
-        raise ParamError("--out", text, "allowed a path that names a folder (not a root, '.' or '..')")
+        raise ParamError(flag, text, "allowed a path that names a folder (not a root, '.' or '..')")
+    size = len(os.fsencode(folder.name))
+    if size > NAME_MAX - _HIDDEN_EXTRA:
+        raise ParamError(flag, _shortened(text), f"allowed a folder name of at most {NAME_MAX - _HIDDEN_EXTRA} "
+                         f"bytes (this one has {size}; the run is staged beside it under a longer name)")
 
 
-def ensure_out_dir(folder: Path) -> Path:
-    """Create ``folder`` (and parents); a bad target is a ParamError naming ``--out``."""
+def _shortened(text: str, keep: int = 60) -> str:
+    return text if len(text) <= 2 * keep else f"{text[:keep]}…{text[-keep:]}"
+
+
+def ensure_out_dir(folder: Path, flag: str = "--out") -> Path:
+    """Create ``folder`` (and parents); a bad target is a ParamError naming ``flag``."""
     folder = Path(folder)
     if folder.exists() and not folder.is_dir():
-        raise ParamError("--out", str(folder), "exists and is not a folder")
+        raise ParamError(flag, str(folder), "exists and is not a folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise ParamError("--out", str(folder), f"cannot create folder: {exc.strerror}") from None
+        raise ParamError(flag, str(folder), f"cannot create folder: {exc.strerror}") from None
     if not os.access(folder, os.W_OK):
-        raise ParamError("--out", str(folder), "folder is not writable")
+        raise ParamError(flag, str(folder), "folder is not writable")
     # os.access says yes to root even where no file can be made (/proc, /sys, read-only mounts):
     # try the real thing, the way every output file is written (a temporary file beside it).
     try:
         fd, probe = tempfile.mkstemp(prefix=".gearcheck-write-test.", suffix=".part", dir=folder)
     except OSError as exc:
-        raise ParamError("--out", str(folder),
+        raise ParamError(flag, str(folder),
                          f"folder is not writable (cannot create a file there: {exc.strerror})") from None
     os.close(fd)
     os.unlink(probe)
@@ -192,24 +216,45 @@ class RunFolder:
     ``with RunFolder(target) as run: ...write into run.staging...; run.commit()``. Leaving the
     block without commit (an exception, an interrupt) removes the staging folder and leaves the
     target as it was. The current run is recorded in :data:`active` so that an interrupt
-    message can name it."""
+    message can name it. A target that is a symbolic link is followed: the folder it points to
+    is replaced, the link stays.
+
+    Beside the target, a run makes only hidden names of its own: ``.NAME.lock``,
+    ``.NAME.staging-XXXXXXXX`` (mkdtemp's eight characters) and ``.NAME.old-PID``. What a killed
+    run left is recognised by exactly these shapes (NAME taken literally, never as a pattern), so
+    no other run's or user's file is ever removed."""
 
     active: RunFolder | None = None  # the run being written now
-    abandoned: str | None = None  # the last target a run left unchanged (failed or interrupted)
+    # what the last run did, for an interrupt's message (one of the two is set)
+    abandoned: str | None = None  # the target it left unchanged (failed or interrupted)
+    written: str | None = None  # the target it replaced (its old run possibly still being removed)
 
     def __init__(self, target: Path):
         target = Path(target)
         check_folder_name(target)
-        self.target = target.absolute()
+        self.target = resolved_target(target)
         self.shown = str(target)
         self.parent = self.target.parent
         self.name = self.target.name
         self._staging: Path | None = None
+        self._old: Path | None = None
         self.committed = False
         self._lock_fd: int | None = None
+        check_folder_name(self.target)  # a link's target names a folder too
 
     def _hidden(self, kind: str) -> str:
         return f".{self.name}{kind}"
+
+    def _leftovers(self, kind: str, tail: str) -> list[Path]:
+        """Hidden folders beside the target of this run's own ``kind`` (staging or old), matched
+        exactly: ``.NAME`` + kind + ``tail`` (a regular expression for the random part)."""
+        shape = re.compile(re.escape(self._hidden(kind)) + tail)
+        try:
+            names = os.listdir(self.parent)
+        except OSError:
+            return []
+        return [self.parent / n for n in names if shape.fullmatch(n) and (self.parent / n).is_dir()
+                and not (self.parent / n).is_symlink()]
 
     # -- lifecycle -----------------------------------------------------------------------------
     def __enter__(self) -> RunFolder:
@@ -235,12 +280,13 @@ class RunFolder:
                  tb: TracebackType | None) -> None:
         staging = self._staging
         if not self.committed and exc is not None:
-            RunFolder.abandoned = self.shown
+            RunFolder.abandoned, RunFolder.written = self.shown, None
         try:
-            if staging is not None and staging.exists():
-                shutil.rmtree(staging, ignore_errors=True)
+            for left in (staging, self._old):  # an interrupt while the old run was being removed
+                if left is not None and left.exists():
+                    shutil.rmtree(left, ignore_errors=True)
         finally:
-            self._staging = None
+            self._staging = self._old = None
             RunFolder.active = None
             self._unlock()
         if isinstance(exc, OSError):
@@ -259,32 +305,39 @@ class RunFolder:
         return self._staging
 
     def commit(self) -> Path:
-        """Swap the staging folder in; the old run (if any) is deleted after the swap."""
+        """Swap the staging folder in; the old run (if any) is deleted after the swap. An
+        interrupt during the swap takes effect once it is done (the target holds the new run);
+        one while the old run is being deleted leaves the new run, and the old one is deleted
+        on the way out."""
         log.info("stage commit: %s", self.shown)
         try:
             (self.staging / RUN_MARKER).write_text(f"gearcheck run folder {self.name}\n", encoding="utf-8")
-            if not self.target.exists():
-                os.rename(self.staging, self.target)
-                old = None
-            elif _exchange(self.staging, self.target):
-                old = self.staging  # now holds the previous run
-            else:
-                old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
-                os.rename(self.target, old)  # a crash here is completed by the next run (_recover)
-                os.rename(self.staging, self.target)
+            with DeferredSignals():
+                if not self.target.exists():
+                    os.rename(self.staging, self.target)
+                    old = None
+                elif _exchange(self.staging, self.target):
+                    old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
+                    os.rename(self.staging, old)  # now holds the previous run: named as what it is
+                else:
+                    old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
+                    os.rename(self.target, old)  # a crash here is completed by the next run (_recover)
+                    os.rename(self.staging, self.target)
+                self._staging, self._old = None, old
+                self.committed = True
+                RunFolder.written, RunFolder.abandoned = self.shown, None
         except OSError as exc:
             raise output_error(exc, self.target) from None
-        self._staging = None
-        self.committed = True
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
+            self._old = None
         return self.target
 
     # -- lock and leftovers --------------------------------------------------------------------
     def _lock(self) -> None:
         path = self.parent / self._hidden(_LOCK)
         try:
-            fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o666 & ~_umask())
+            fd = os.open(path, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW, 0o666 & ~_umask())
         except OSError as exc:
             raise output_error(exc, path) from None
         try:
@@ -305,10 +358,27 @@ class RunFolder:
     def _recover(self) -> None:
         """Under the lock: finish what a killed run left. A previous run moved aside but never
         replaced is put back; staging folders and swapped-out old runs are deleted."""
-        olds = sorted(self.parent.glob(self._hidden(_OLD) + "*"), key=lambda p: p.stat().st_mtime)
-        if not self.target.exists() and olds:
+        olds = sorted(self._leftovers(_OLD, r"[0-9]+"), key=lambda p: p.stat().st_mtime)
+        if not self.target.exists() and not self.target.is_symlink() and olds:
             log.info("restoring %s from an interrupted swap", self.target)
             os.rename(olds.pop(), self.target)
-        for left in [*olds, *self.parent.glob(self._hidden(_STAGING) + "*")]:
+        for left in [*olds, *self._leftovers(_STAGING, r"[a-z0-9_]{8}")]:
             log.info("removing %s left by an interrupted run", left)
             shutil.rmtree(left, ignore_errors=True)
+
+
+def remove_leftovers(folder: Path) -> None:
+    """What a run into ``folder`` that was stopped without a chance to clean up (a worker
+    process killed by its parent) left beside it: removed, under the folder's lock. Nothing is
+    done while another run holds the lock, nor where the folder's name is not one a run uses."""
+    try:
+        run = RunFolder(folder)
+        run._lock()
+    except (ParamError, OSError):
+        return
+    try:
+        run._recover()
+    except OSError as exc:
+        log.info("leftovers of %s not removed: %s", folder, exc)
+    finally:
+        run._unlock()

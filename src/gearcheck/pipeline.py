@@ -186,8 +186,10 @@ def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: Pr
     written into ``folder`` (a staging folder: the caller commits it). The solids, meshes and
     STEP file come from the CAD cache when it holds this design's (:func:`_cached_cad`), and go
     into it when made."""
-    from gearcheck import cache
+    from gearcheck import cache, resolution
     from gearcheck.cad.export import cad_bytes, export_parts
+    from gearcheck.cad.mesh import TooManyTriangles
+    from gearcheck.mesh_budget import over_budget, within_budget
 
     plan = mesh_plan(design, tol_mm)
     tol = plan.tol_mm
@@ -201,16 +203,27 @@ def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: Pr
         made = meshed = step = None
         log.info("stage build: %s (%s), solids", design.name, design.mechanism)
         assembly, parts = build_parts(design, progress, assembly)
+        budgeted = within_budget(design, plan, parts, tol_mm)
+        if budgeted is not plan:
+            plan, tol = budgeted, budgeted.tol_mm
+            key = cad_key(design, assembly, tol) if key is not None else None
     log.info("stage mesh: %s, %d parts at %g mm", design.name, len(parts), tol)
     source = {"key": key, "reused": cached is not None, "made": made}
-    with progress(f"meshing {design.name}", len(parts), "part") as bar:
-        manifest, exported, step_data = export_parts(
-            parts, folder, name=design.name, mechanism=design.mechanism, params_data=run_params(design, tol),
-            tol_mm=tol, extra={"mesh_tolerance": plan.manifest(), "cad_cache": source},
-            progress=lambda _name: bar.update(1), params_comment=provenance(design, overrides),
-            meshed=meshed, step_data=step)
-        if meshed is not None:
-            bar.update(len(parts))
+    while True:
+        try:
+            with progress(f"meshing {design.name}", len(parts), "part") as bar:
+                manifest, exported, step_data = export_parts(
+                    parts, folder, name=design.name, mechanism=design.mechanism, params_data=run_params(design, tol),
+                    tol_mm=tol, extra={"mesh_tolerance": plan.manifest(), "cad_cache": source},
+                    progress=lambda _name: bar.update(1), params_comment=provenance(design, overrides),
+                    meshed=meshed, step_data=step, max_triangles=resolution.TRIANGLE_BUDGET)
+                if meshed is not None:
+                    bar.update(len(parts))
+            break
+        except TooManyTriangles as exc:  # more than the estimate said: counted while meshing
+            plan = over_budget(design, plan, parts, tol_mm, exc.triangles)
+            tol = plan.tol_mm
+            key = source["key"] = cad_key(design, assembly, tol) if key is not None else None
     if cached is None and key is not None:
         meshes = [(e.mesh, e.brep_volume_mm3) for e in exported]
         cache.store(cache.root(), key, {"cad.pickle": cad_bytes(parts, meshes), "model.step": step_data})

@@ -35,6 +35,11 @@ BOUND_PER_CLEARANCE = 0.1
 PARTS_PER_PAIR = 2
 # The finest tolerance a mesh is made at to resolve a clearance (finer: the exact B-rep decides).
 FINEST_TOL_MM = TOL_MIN_MM
+# The most triangles one run's meshes may hold (each distinct solid once), estimated before
+# meshing: about 0.6 KB each through meshing, the sweep's BVHs on every process and the files,
+# so some 2 GB at the budget. A finer tolerance asked for is refused with the finest that fits;
+# one the resolution rule would choose stops at the budget (the exact B-rep decides the rest).
+TRIANGLE_BUDGET = 3_000_000
 
 
 @dataclass(frozen=True)
@@ -45,6 +50,7 @@ class MeshPlan:
     requested_mm: float  # --tol / mesh_tol_mm, else the mechanism's default
     explicit: bool  # the user fixed the tolerance: it is used as given
     clearance: Clearance | None  # the smallest clearance to decide (exact model, before meshing)
+    budget_limited: bool = False  # the rule's tolerance was coarsened to fit TRIANGLE_BUDGET
 
     @property
     def needed_mm(self) -> float | None:
@@ -65,6 +71,8 @@ class MeshPlan:
         if self.clearance is not None:
             out |= {"smallest_clearance_mm": self.clearance.value_mm, "smallest_clearance": self.clearance.label,
                     "resolving_tol_mm": self.needed_mm}
+        if self.budget_limited:
+            out["triangle_budget"] = TRIANGLE_BUDGET
         return out
 
 
@@ -82,6 +90,15 @@ def plan_tolerance(requested_mm: float, explicit: bool, clearance: Clearance | N
     tol = float(f"{needed:.3g}")
     tol = tol if tol <= needed else float(f"{needed * (1 - 5e-3):.3g}")
     return MeshPlan(tol, requested_mm, explicit, clearance)
+
+
+def fitting_tolerance(tol_mm: float, estimated: int, budget: int,
+                      exponent: float = 1.1) -> float:
+    """The finest tolerance (2 significant digits, rounded up) at which meshes estimated at
+    ``estimated`` triangles for ``tol_mm`` hold at most ``budget`` (triangles ∝ tol^−exponent)."""
+    fit = tol_mm * (estimated / budget) ** (1.0 / exponent)
+    rounded = float(f"{fit:.2g}")
+    return rounded if rounded >= fit else float(f"{fit * 1.05:.2g}")
 
 
 def pair_bound(bodies: Mapping[str, Any]) -> tuple[str, float]:

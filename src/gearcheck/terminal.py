@@ -90,8 +90,8 @@ Examples:
 Output: tables and coloured PASS / WARN / FAIL on a terminal, wrapped to its width (NO_COLOR:
 the same without colours); plain text when piped, not wrapped: one verdict per line, for grep.
 Progress bars with totals and the time left go to stderr when it is a terminal.
-Exit codes: 0 no verdict fails (warnings included), 1 a verdict fails, 2 bad input, 130 / 143
-interrupted.
+Exit codes: 0 no verdict fails (warnings included), 1 a verdict fails, 2 bad input, 3 an internal
+error (a worker process killed; -v shows the traceback), 130 / 143 interrupted.
 """
 
 TOL_HELP = ("absolute chordal tolerance of the meshes in mm, used as given (default per mechanism: {defaults}, "

@@ -22,7 +22,7 @@ import numpy as np
 
 from gearcheck import __version__
 from gearcheck.cad.bevel import volume_mm3
-from gearcheck.cad.mesh import CHORDAL_TOL_MM, TriMesh, mesh_shape
+from gearcheck.cad.mesh import CHORDAL_TOL_MM, TooManyTriangles, TriMesh, mesh_shape
 from gearcheck.cad.placement import Part, location
 from gearcheck.cad.step import StepWriteError, appearance, write_step
 from gearcheck.output import atomic_write_bytes, atomic_write_text, ensure_out_dir
@@ -74,17 +74,25 @@ def cad_assembly(parts: list[Part], assembly_name: str) -> cq.Assembly:
     return assy
 
 
-def mesh_parts(parts: list[Part], tol_mm: float = CHORDAL_TOL_MM, progress=None) -> list[tuple[TriMesh, float]]:
+def mesh_parts(parts: list[Part], tol_mm: float = CHORDAL_TOL_MM, progress=None,
+               max_triangles: int | None = None) -> list[tuple[TriMesh, float]]:
     """(mesh in the part's own frame, B-rep volume in mm³) of every part, in order; copies share
     a solid, and are meshed once (they share the mesh). ``progress`` (optional) is called with
-    each part name as it is meshed. Meshing leaves each solid carrying its triangulation."""
+    each part name as it is meshed. Meshing leaves each solid carrying its triangulation.
+    ``max_triangles``: once the distinct meshes hold more, :class:`TooManyTriangles` is raised
+    (the parts after it are not meshed)."""
     meshed: dict[int, tuple[TriMesh, float]] = {}
     out = []
+    total = 0
     for part in parts:
         if progress:
             progress(part.name)
         if id(part.solid) not in meshed:
-            meshed[id(part.solid)] = (mesh_shape(part.solid, tol_mm), float(volume_mm3(part.solid)))
+            mesh = mesh_shape(part.solid, tol_mm)
+            total += len(mesh.faces)
+            if max_triangles is not None and total > max_triangles:
+                raise TooManyTriangles(total, max_triangles)
+            meshed[id(part.solid)] = (mesh, float(volume_mm3(part.solid)))
         out.append(meshed[id(part.solid)])
     return out
 
@@ -115,19 +123,20 @@ def export_parts(
     params_comment: str = "",
     meshed: list[tuple[TriMesh, float]] | None = None,
     step_data: bytes | None = None,
+    max_triangles: int | None = None,
 ) -> tuple[dict, list[ExportedPart], bytes]:
     """Mesh and write every part, the STEP assembly, params.toml and manifest.json; returns the
     manifest, the exported parts (meshes in their own frames) and the STEP file's bytes.
     ``progress`` (optional) is called with each part name as it is meshed. ``meshed`` (one
     :func:`mesh_parts` entry per part) and ``step_data`` (a STEP file of these parts, its header
     stamped again now) are used instead of meshing and writing the STEP anew: a design's CAD
-    from the cache."""
+    from the cache. ``max_triangles``: as for :func:`mesh_parts`."""
     folder = ensure_out_dir(folder)
     names = [p.name for p in parts]
     if len(set(names)) != len(names):
         raise ValueError(f"part names must be unique: {names}")
     if meshed is None:
-        meshed = mesh_parts(parts, tol_mm, progress)
+        meshed = mesh_parts(parts, tol_mm, progress, max_triangles)
     exported: list[ExportedPart] = []
     for part, (mesh, volume) in zip(parts, meshed, strict=True):
         stl = folder / f"{part.name}.stl"

@@ -10,8 +10,11 @@ from __future__ import annotations
 
 import copy
 import math
+import os
 import re
+import stat
 import tomllib
+import types
 import typing
 from collections.abc import Callable
 from decimal import ROUND_HALF_EVEN, Decimal, localcontext
@@ -197,18 +200,50 @@ def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:
 
 def _field_type(model: type[BaseModel], path: tuple[str, ...]) -> str:
     """The declared type at ``path`` (list items by index), e.g. 'list[float]', 'float'; '' if unknown."""
+    current = _annotation_at(model, path, unwrap=False)
+    if current is None:
+        return ""
+    if isinstance(current, type):
+        return current.__name__
+    return str(current).replace("typing.", "")
+
+
+def _annotation_at(model: type[BaseModel], path: tuple[str, ...], unwrap: bool) -> Any:
+    """The annotation at ``path`` (list items by index; with ``unwrap``, ``Annotated`` and
+    ``X | None`` looked through at every step); None where the path leads nowhere."""
     current: Any = model
     for name in path:
+        if unwrap:
+            current = _unwrap(current)
         fields = getattr(current, "model_fields", None)
         if fields and name in fields:
             current = fields[name].annotation
         elif name.isdigit() and typing.get_origin(current) is list:
             current = typing.get_args(current)[0]
         else:
-            return ""
-    if isinstance(current, type):
-        return current.__name__
-    return str(current).replace("typing.", "")
+            return None
+    return _unwrap(current) if unwrap else current
+
+
+def _unwrap(annotation: Any) -> Any:
+    """The type inside ``Annotated[...]`` and ``X | None``."""
+    while True:
+        origin = typing.get_origin(annotation)
+        if origin is typing.Annotated:
+            annotation = typing.get_args(annotation)[0]
+        elif origin in (typing.Union, types.UnionType):
+            args = [a for a in typing.get_args(annotation) if a is not type(None)]
+            if len(args) != 1:
+                return annotation
+            annotation = args[0]
+        else:
+            return annotation
+
+
+def _model_at(model: type[BaseModel], path: tuple[str, ...]) -> type[BaseModel] | None:
+    """The model (a section, or an item of a list of sections) at ``path``; None where there is none."""
+    current = _annotation_at(model, path, unwrap=True)
+    return current if isinstance(current, type) and issubclass(current, BaseModel) else None
 
 
 def _first_error(model: type[BaseModel], exc: ValidationError, data: dict) -> ParamError:
@@ -218,11 +253,10 @@ def _first_error(model: type[BaseModel], exc: ValidationError, data: dict) -> Pa
     kind = err["type"]
     value = err.get("input")
     if kind == "extra_forbidden":
-        parent: Any = model
-        for name in loc[:-1]:
-            parent = parent.model_fields[name].annotation if name in getattr(parent, "model_fields", {}) else None
-        known = ", ".join(sorted(parent.model_fields)) if parent is not None and hasattr(parent, "model_fields") else ""
-        return ParamError(path, value, f"unknown key (allowed keys here: {known})")
+        parent = _model_at(model, loc[:-1])
+        known = ", ".join(sorted(parent.model_fields)) if parent is not None else ""
+        return ParamError(path, value, f"unknown key (allowed keys here: {known})" if known
+                          else "unknown key (no keys are allowed here)")
     if kind == "missing":
         return ParamError(path, MISSING, "required key is missing")
     return ParamError(path, value, _value_problem(model, loc, kind, value, err["msg"]))
@@ -479,6 +513,42 @@ def _match_end(pattern: re.Pattern[str], text: str, pos: int) -> int:
     return found.end() if found is not None else pos
 
 
+# What a path that is not a regular file is, as a rejection names it.
+_FILE_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+               (stat.S_ISFIFO, "a named pipe"), (stat.S_ISSOCK, "a socket"))
+
+
+def _read_template_bytes(path: Path, source: str) -> bytes:
+    """The bytes of a template file: a regular file (a device, a pipe or a socket is refused, not
+    read: /dev/urandom never ends, a pipe may never be written) of at most MAX_TEMPLATE_BYTES."""
+    try:
+        # non-blocking: opening a pipe does not wait for a writer (it is refused just below)
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_BINARY", 0))
+    except OSError as exc:
+        raise ParamError("", None, f"cannot read: {exc.strerror}", source) from None
+    with os.fdopen(fd, "rb") as f:
+        mode = os.fstat(f.fileno()).st_mode
+        if stat.S_ISDIR(mode):
+            raise ParamError("", None, "is a folder, expected a .toml template", source)
+        if not stat.S_ISREG(mode):
+            kind = next((name for test, name in _FILE_KINDS if test(mode)), "not a regular file")
+            raise ParamError("", None, f"not a TOML text file: {kind} (a template is a regular file of UTF-8 "
+                             "text)", source)
+        size = os.fstat(f.fileno()).st_size
+        if size == 0:
+            raise ParamError("", None, "empty file, expected a TOML template", source)
+        if size > MAX_TEMPLATE_BYTES:
+            raise ParamError("", None, f"file is {size} bytes; a template is at most {MAX_TEMPLATE_BYTES}", source)
+        try:
+            data = f.read(MAX_TEMPLATE_BYTES + 1)
+        except OSError as exc:
+            raise ParamError("", None, f"cannot read: {exc.strerror}", source) from None
+    if len(data) > MAX_TEMPLATE_BYTES:  # grew since its size was read
+        raise ParamError("", None, f"file is more than {MAX_TEMPLATE_BYTES} bytes; a template is at most "
+                         f"{MAX_TEMPLATE_BYTES}", source)
+    return data
+
+
 def read_toml(path: Path) -> dict:
     """Read a template file; every way it can be unreadable is a ParamError naming the file."""
     source = str(path)
@@ -486,18 +556,16 @@ def read_toml(path: Path) -> dict:
         raise ParamError("", None, "file not found", source)
     if path.is_dir():
         raise ParamError("", None, "is a folder, expected a .toml template", source)
-    size = path.stat().st_size
-    if size == 0:
-        raise ParamError("", None, "empty file, expected a TOML template", source)
-    if size > MAX_TEMPLATE_BYTES:
-        raise ParamError("", None, f"file is {size} bytes; a template is at most {MAX_TEMPLATE_BYTES}", source)
+    raw = _read_template_bytes(path, source)
     try:
         # utf-8-sig: a byte-order mark (some Windows editors write one) is not part of the text
-        text = path.read_bytes().decode("utf-8-sig")
+        text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
-        raise ParamError("", None, f"not UTF-8 text (byte {exc.start}): is this a TOML template?", source) from None
-    except OSError as exc:
-        raise ParamError("", None, f"cannot read: {exc.strerror}", source) from None
+        raise ParamError("", None, f"not a TOML text file: binary data, not UTF-8 text (byte {exc.start})",
+                         source) from None
+    if "\0" in text:
+        raise ParamError("", None, f"not a TOML text file: binary data (a NUL character at {text.index(chr(0))})",
+                         source)
     problem = _prescan(text)
     if problem is not None:
         line, what = problem

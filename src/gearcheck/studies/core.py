@@ -7,24 +7,32 @@ import contextlib
 import json
 import logging
 import math
+import os
+import tempfile
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from gearcheck.params import ParamError
 from gearcheck.pipeline import ProgressFactory, no_progress
 from gearcheck.studies import stats
 from gearcheck.studies.run import Base, run_level
-from gearcheck.studies.sampling import draw, field_values, nominal_values
-from gearcheck.studies.spec import StudySpec, load_spec, template_path
+from gearcheck.studies.sampling import draw, field_values, integer_fields, nominal_values
+from gearcheck.studies.spec import (FIGURE_LEVELS, StudySpec, check_outputs, check_scheduler, load_spec,
+                                    template_path, with_flags)
 
 log = logging.getLogger("gearcheck")
 
 REJECTIONS_LISTED = 200  # in summary.json (every one is in results.parquet)
 FILES = ("results.parquet", "summary.json", "report.html")
+# How long a Dask scheduler given by address may take to answer (seconds; the environment
+# variable overrides it, e.g. for a scheduler on a slow network).
+SCHEDULER_TIMEOUT_S = 20.0
+SCHEDULER_TIMEOUT_ENV = "GEARCHECK_SCHEDULER_TIMEOUT"
 
 
 @dataclass
@@ -41,15 +49,54 @@ class StudyResult:
         return self.table.to_pandas()
 
 
+def scheduler_timeout() -> float:
+    """Seconds a Dask scheduler given by address may take to answer (:data:`SCHEDULER_TIMEOUT_S`,
+    or ``$GEARCHECK_SCHEDULER_TIMEOUT``)."""
+    text = os.environ.get(SCHEDULER_TIMEOUT_ENV)
+    if text is None:
+        return SCHEDULER_TIMEOUT_S
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not 0 < value <= 3600:
+        raise ParamError(SCHEDULER_TIMEOUT_ENV, text, "allowed a number of seconds > 0 to 3600")
+    return value
+
+
 @contextlib.contextmanager
-def _executor(jobs: int | None, scheduler: str | None) -> Iterator[Any]:
+def _executor(jobs: int | None, scheduler: str | None, timeout: float = SCHEDULER_TIMEOUT_S) -> Iterator[Any]:
     from gearcheck.executor import DaskExecutor, make_executor
 
-    if scheduler:
-        with DaskExecutor(scheduler, jobs) as ex:
-            yield ex
-    else:
+    if not scheduler:
         yield make_executor(jobs)
+        return
+    try:
+        executor = DaskExecutor(scheduler, jobs, timeout=timeout)
+    except OSError:  # refused, unreachable, or no answer in time: distributed retries until the timeout
+        if scheduler == "local-cluster":
+            raise
+        raise ParamError("--scheduler", scheduler, f"no Dask scheduler answered within {timeout:g} s (start one "
+                         "with `dask scheduler`, or run on --scheduler local-cluster)") from None
+    except (TypeError, ValueError) as exc:  # e.g. tls:// without Dask's TLS configuration
+        if scheduler == "local-cluster":
+            raise
+        raise ParamError("--scheduler", scheduler, f"could not connect: {exc}") from None
+    with executor:
+        yield executor
+
+
+def study_figures(spec: StudySpec, base: Base) -> list[str]:
+    """The figures (``LEVEL.KEY``) the template's own values give at each level the study names
+    an output of (the analytical level always): the names its outputs may take."""
+    from gearcheck import mechanism as registry
+    from gearcheck.design import from_data
+
+    named = {spec.rank_by, *(f.output for f in spec.failures), *(p.output for p in spec.paper)}
+    levels = [lv for lv in FIGURE_LEVELS if lv == "analytical" or any(n.startswith(f"{lv}.") for n in named)]
+    impl = registry.get(base.mechanism)
+    params = from_data(base.data).params
+    return [f"{lv}.{k}" for lv in levels for k in impl.study_row(params, lv)]
 
 
 def _prefixed(level: str, cols: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -79,9 +126,11 @@ def shown(path: Path) -> str:
 
 
 def evaluate(spec: StudySpec, base: Base, inputs: dict[str, np.ndarray], executor: Any,
-             progress: ProgressFactory = no_progress, exact: int | None = None) -> dict[str, Any]:
+             progress: ProgressFactory = no_progress, exact: int | None = None,
+             figures: Iterable[str] = ()) -> dict[str, Any]:
     """Levels 1 and 2 over the variants (``inputs``: the template fields each sets): validity,
-    rejection reasons and figure columns."""
+    rejection reasons and figure columns (each of ``figures`` among them, NaN where no variant
+    gave it: all rejected, or a level not run)."""
     n = len(next(iter(inputs.values())))
     all_idx = np.arange(n)
     t0 = time.perf_counter()
@@ -96,6 +145,7 @@ def evaluate(spec: StudySpec, base: Base, inputs: dict[str, np.ndarray], executo
     with progress("study: exact model", len(exact_idx), "variant") as bar:
         second = run_level(base, "exact", inputs, exact_idx, executor, bar.update)
     cols |= _prefixed("exact", _scatter(n, exact_idx, second.columns))
+    cols |= {k: np.full(n, math.nan) for k in figures if k not in cols}
     t2 = time.perf_counter()
     return {"valid": valid, "rejection": rejection, "figures": cols, "exact_rows": exact_idx,
             "timings": {"analytical_s": t1 - t0, "exact_s": t2 - t1, "analytical_variants": n,
@@ -108,8 +158,6 @@ def worst_variants(spec: StudySpec, figures: dict[str, np.ndarray], valid: np.nd
         return []
     key = spec.rank_by
     if key not in figures:
-        from gearcheck.params import ParamError
-
         raise ParamError("rank_by", key, f"allowed one of the study's figures: {', '.join(sorted(figures))}")
     v = np.where(valid & np.isfinite(figures[key]), figures[key], np.inf)
     order = np.argsort(v, kind="stable")
@@ -118,7 +166,11 @@ def worst_variants(spec: StudySpec, figures: dict[str, np.ndarray], valid: np.nd
 
 def run_checks(base: Base, inputs: dict[str, np.ndarray], picks: list[int], folder: Path | None, jobs: int | None,
                progress: ProgressFactory = no_progress) -> list[dict]:
-    """Level 3: the full check of each picked variant, in ``folder/checks/variant_NNNNN``."""
+    """Level 3: the full check of each picked variant, in ``folder/checks/variant_NNNNN``.
+
+    A check is a run folder of its own (locked, staged, swapped in): it runs in a temporary
+    folder (inside ``folder``: same file system) and only its finished folder is moved in, so
+    the study's folder holds the checks' files and none of their transactions' (a lock file)."""
     from gearcheck import pipeline
     from gearcheck.design import from_data
     from gearcheck.studies.run import variant_data
@@ -128,14 +180,11 @@ def run_checks(base: Base, inputs: dict[str, np.ndarray], picks: list[int], fold
         design = from_data(variant_data(base, {f: float(inputs[f][i]) for f in inputs}))
         name = f"variant_{i:05d}"
         target = (folder / "checks" / name) if folder is not None else None
-        if target is None:
-            import tempfile
-
-            with tempfile.TemporaryDirectory() as tmp:
-                run = pipeline.check(design, Path(tmp) / name, jobs=jobs, progress=progress)
-        else:
-            target.parent.mkdir(exist_ok=True)
-            run = pipeline.check(design, target, jobs=jobs, progress=progress)
+        with tempfile.TemporaryDirectory(prefix=".check-", dir=folder) as tmp:
+            run = pipeline.check(design, Path(tmp) / name, jobs=jobs, progress=progress)
+            if target is not None:
+                target.parent.mkdir(exist_ok=True)
+                os.rename(Path(tmp) / name, target)
         result = run.result
         out.append({"variant": i, "folder": f"checks/{name}" if target is not None else "",
                     "level": result.level, "passed": bool(result.passed),
@@ -153,8 +202,6 @@ def summarise(spec: StudySpec, template: str, inputs: dict[str, np.ndarray], ev:
     failures = {}
     for f in spec.failures:
         if f.output not in figures:
-            from gearcheck.params import ParamError
-
             raise ParamError(f"failures[{f.name}].output", f.output,
                              f"allowed one of the study's figures: {', '.join(sorted(figures))}")
         v = figures[f.output]
@@ -235,28 +282,37 @@ def study(path: str | Path, *, samples: int | None = None, seed: int | None = No
     """Run a study file. ``out``: the folder to write (one transaction), or None for no files
     (level 3 then runs in temporary folders). ``scheduler``: None (local processes, ``jobs``
     of them; 1 runs in this process), ``"local-cluster"`` (a Dask LocalCluster of ``jobs``
-    workers) or ``"tcp://HOST:PORT"`` (an existing Dask cluster)."""
+    workers) or ``"tcp://HOST:PORT"`` / ``"tls://HOST:PORT"`` (an existing Dask cluster, which
+    must answer within 20 s, or ``$GEARCHECK_SCHEDULER_TIMEOUT`` seconds). ``samples``,
+    ``seed``, ``exact`` and ``check_worst`` override the study file's, within its limits.
+
+    Everything is checked before any variant is drawn (one-line :class:`ParamError`): the
+    study file, the overrides, the scheduler's address, and that ``rank_by`` and every
+    failure's output name a figure of the mechanism. A study whose every variant the template
+    rejects is an error too (the first rejection's reason), and writes nothing."""
     from gearcheck.design import load
     from gearcheck.output import RunFolder, atomic_write_bytes, atomic_write_text
 
     path = Path(path)
-    spec = load_spec(path)
+    check_scheduler(scheduler)
+    timeout = scheduler_timeout() if scheduler not in (None, "local-cluster") else SCHEDULER_TIMEOUT_S
+    spec = with_flags(load_spec(path), samples=samples, seed=seed, exact=exact, check_worst=check_worst)
     tpl = template_path(spec, path)
     design = load(tpl)
-    n = spec.samples if samples is None else int(samples)
-    s = spec.seed if seed is None else int(seed)
-    if n < 2:
-        from gearcheck.params import ParamError
-
-        raise ParamError("--samples", n, "allowed ≥ 2")
+    n, s, k = spec.samples, spec.seed, spec.check_worst
     nominal = nominal_values(design.data, [i.field for i in spec.inputs])
+    base = Base(design.mechanism, design.data, integer_fields(spec, nominal))
+    figures = study_figures(spec, base)
+    check_outputs(spec, set(figures), str(path))
     inputs = draw(spec, nominal, n, s)
     fields = field_values(spec, nominal, inputs)
-    base = Base(design.mechanism, design.data)
-    k = spec.check_worst if check_worst is None else int(check_worst)
     t0 = time.perf_counter()
-    with _executor(jobs, scheduler) as executor:
-        ev = evaluate(spec, base, fields, executor, progress, exact)
+    with _executor(jobs, scheduler, timeout) as executor:
+        ev = evaluate(spec, base, fields, executor, progress, figures=figures)
+    if not ev["valid"].any():
+        first = next(i for i, r in enumerate(ev["rejection"]) if r)
+        raise ParamError("", None, f"every one of the {n} variants was rejected by the template's checks, nothing "
+                         f"to report; the first, variant {first}: {ev['rejection'][first]}", str(path))
     picks = worst_variants(spec, ev["figures"], ev["valid"], k)
 
     def finish(folder: Path | None) -> StudyResult:

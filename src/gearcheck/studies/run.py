@@ -33,16 +33,20 @@ CHUNK = {"analytical": 64, "exact": 4}
 
 @dataclass(frozen=True)
 class Base:
-    """What every worker needs: the mechanism and the template's data (small, picklable)."""
+    """What every worker needs: the mechanism, the template's data and the fields sampled as
+    whole numbers (small, picklable)."""
 
     mechanism: str
     data: dict
+    integers: frozenset[str] = frozenset()
 
 
 def variant_data(base: Base, values: dict[str, float]) -> dict:
+    """The template's data with a variant's values set (a whole-number field as an int)."""
     from gearcheck.params.common import apply_values
 
-    return apply_values(base.data, values)
+    return apply_values(base.data, {f: int(v) if f in base.integers and math.isfinite(v) else v
+                                    for f, v in values.items()})
 
 
 def _numbers(row: dict) -> dict[str, float]:

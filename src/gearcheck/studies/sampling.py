@@ -84,6 +84,19 @@ def field_values(spec: StudySpec, nominal: dict[str, float], inputs: dict[str, n
     return out
 
 
+def integer_fields(spec: StudySpec, nominal: dict[str, float]) -> frozenset[str]:
+    """The template fields every variant sets to whole numbers (a tooth count): those every
+    input acting on is ``integer`` (a field only offset: from a whole template value), and the
+    fields that take their values (``also``). The template gets them as ints, as its own file
+    has them."""
+    acting: dict[str, list[Input]] = {}
+    for inp in spec.inputs:
+        acting.setdefault(inp.field, []).append(inp)
+    whole = {f for f, inps in acting.items() if all(i.integer for i in inps)
+             and (any(i.mode == "value" for i in inps) or float(nominal[f]).is_integer())}
+    return frozenset(whole | {other for inp in spec.inputs if inp.field in whole for other in inp.also})
+
+
 def nominal_values(data: dict, fields: list[str]) -> dict[str, float]:
     """The template's value of each field (a field the template leaves to its default must be
     given a mean or bounds in the study)."""

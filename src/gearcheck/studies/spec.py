@@ -10,23 +10,37 @@ data-sheet spread). Bad input is one line naming the field, its value and the al
 
 from __future__ import annotations
 
+import re
+import unicodedata
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import Field, model_validator
+from pydantic import Field, TypeAdapter, ValidationError, model_validator
 
 from gearcheck.params import ParamError, read_toml, validate
-from gearcheck.params.common import Section
+from gearcheck.params.common import MISSING, Section, field_range
 
 # A study's size limits: enough for any tolerance study, small enough that a typo cannot ask for
-# a week of CPU (the analytical level is vectorised and takes far more; the API can pass more).
+# a week of CPU (the analytical level is vectorised and takes far more: the sampling and level
+# functions, which the benchmarks call, take any size). The command line's flags and the API's
+# keywords that override them are held to the same limits (:func:`flag_value`).
 MAX_SAMPLES = 1_000_000
 MAX_EXACT = 100_000
 MAX_CHECKS = 20
 LEVELS = ("analytical", "exact", "check")
+# the levels whose figures a study's outputs name (``LEVEL.KEY``)
+FIGURE_LEVELS = ("analytical", "exact")
 
 FieldPath = Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)+$", max_length=120)]
 Text = Annotated[str, Field(min_length=1, max_length=400)]
+PRINTABLE = "allowed printable text (no control characters: escape sequences, bells, tabs, line breaks)"
+
+
+def _printable(where: str, text: str | None) -> None:
+    """Free text of a study file is shown on the terminal and in report.html as it is: control
+    and format characters (an ANSI escape, a bell, a right-to-left override) are refused."""
+    if text is not None and any(unicodedata.category(c) in ("Cc", "Cf", "Zl", "Zp") for c in text):
+        raise ParamError(where, text, PRINTABLE)
 
 
 class Input(Section):
@@ -43,7 +57,7 @@ class Input(Section):
     unit: Annotated[str, Field(max_length=20)]
     reason: Text
     mean: float | None = None  # default: the template's value
-    sd: Annotated[float, Field(ge=0.0)] | None = None
+    sd: float | None = None  # ≥ 0, checked with the distribution's shape (the message names the input)
     low: float | None = None
     high: float | None = None
     integer: bool = False  # round each draw to the nearest integer (tooth counts)
@@ -57,12 +71,17 @@ class Input(Section):
     def _shape(self) -> Input:
         d = self.distribution
         where = f"inputs[{self.key}]"
+        _printable(f"{where}.unit", self.unit)
+        _printable(f"{where}.reason", self.reason)
+        if self.sd is not None and self.sd < 0:
+            raise ParamError(f"{where}.sd", self.sd, "out of range: allowed ≥ 0 (a standard deviation)")
         if d in ("normal", "truncnorm") and self.sd is None:
-            raise ParamError(f"{where}.sd", "missing", f"required for a {d} distribution: a standard deviation ≥ 0")
+            raise ParamError(f"{where}.sd", MISSING, f"required for a {d} distribution: a standard deviation ≥ 0")
         if d == "uniform" and (self.low is None or self.high is None):
-            raise ParamError(f"{where}.low/high", "missing", "required for a uniform distribution: low ≤ high")
+            side = "low" if self.low is None else "high"
+            raise ParamError(f"{where}.{side}", MISSING, "required for a uniform distribution: low ≤ high")
         if d == "truncnorm" and self.low is None and self.high is None:
-            raise ParamError(f"{where}.low/high", "missing", "a truncated normal needs low, high or both")
+            raise ParamError(f"{where}.low/high", MISSING, "a truncated normal needs low, high or both")
         if self.low is not None and self.high is not None and not self.low <= self.high:
             raise ParamError(f"{where}.high", self.high, f"allowed ≥ low = {self.low:g}")
         if d == "uniform" and (self.mean is not None or self.sd is not None):
@@ -82,8 +101,14 @@ class Failure(Section):
 
     @model_validator(mode="after")
     def _one_side(self) -> Failure:
-        if (self.below is None) == (self.above is None):
-            raise ParamError(f"failures[{self.name}]", "below/above", "exactly one of below or above")
+        where = f"failures[{self.name}]"
+        _printable(f"{where}.label", self.label)
+        if self.below is None and self.above is None:
+            raise ParamError(f"{where}.below/above", MISSING,
+                             "required: one limit, below (fails under it) or above (fails over it)")
+        if self.below is not None and self.above is not None:
+            raise ParamError(f"{where}.above", self.above,
+                             f"allowed only one of below or above (below = {self.below:g} is given too)")
         return self
 
     def failed(self, value: float) -> bool:
@@ -96,6 +121,11 @@ class Paper(Section):
     output: Annotated[str, Field(min_length=1, max_length=120)]
     value: float
     label: Text
+
+    @model_validator(mode="after")
+    def _text(self) -> Paper:
+        _printable(f"paper[{self.output}].label", self.label)
+        return self
 
 
 class StudySpec(Section):
@@ -117,6 +147,8 @@ class StudySpec(Section):
 
     @model_validator(mode="after")
     def _unique(self) -> StudySpec:
+        _printable("title", self.title)
+        _printable("template", self.template)
         values = [i.field for i in self.inputs if i.mode == "value"]
         for f in values:
             if values.count(f) > 1:
@@ -130,6 +162,68 @@ class StudySpec(Section):
             if names.count(n) > 1:
                 raise ParamError("failures.name", n, "failure names must be unique")
         return self
+
+
+# The study file's numbers that the command line (and the API's keywords) may override.
+FLAGS = {"samples": "--samples", "seed": "--seed", "exact": "--exact", "check_worst": "--check-worst"}
+_FLAG_NOTES = {"exact": " (-1: every variant)"}
+
+
+def flag_value(name: str, value: int | str) -> int:
+    """A value given for one of the study file's numbers (``name``: samples, seed, exact or
+    check_worst; ``value``: the API's int or the command line's text), checked against the
+    limits the study file's own field has: one-line :class:`ParamError` naming the flag."""
+    flag = FLAGS[name]
+    allowed = f"{field_range(StudySpec, (name,))}{_FLAG_NOTES.get(name, '')}"
+    number: object = value
+    if isinstance(value, str):
+        number = int(value) if re.fullmatch(r"\s*[-+]?[0-9]{1,30}\s*", value) else None
+    if not isinstance(number, int) or isinstance(number, bool):
+        raise ParamError(flag, value, allowed.replace("allowed ", "allowed a whole number ", 1))
+    info = StudySpec.model_fields[name]
+    constrained: Any = Annotated[(info.annotation, *info.metadata)]  # the field's type with its bounds
+    try:
+        TypeAdapter(constrained).validate_python(number)
+    except ValidationError:
+        raise ParamError(flag, number, allowed) from None
+    return number
+
+
+def with_flags(spec: StudySpec, **values: int | str | None) -> StudySpec:
+    """The study with the given overrides (None: the study file's value), each checked by
+    :func:`flag_value`."""
+    update = {k: flag_value(k, v) for k, v in values.items() if v is not None}
+    return spec.model_copy(update=update)
+
+
+_HOST = r"(?:\[[0-9A-Fa-f:.]{2,45}\]|[A-Za-z0-9](?:[A-Za-z0-9.-]{0,251}[A-Za-z0-9])?)"
+SCHEDULERS = "allowed local-cluster, or tcp://HOST:PORT or tls://HOST:PORT of a running Dask scheduler"
+
+
+def check_scheduler(address: str | None) -> str | None:
+    """``--scheduler``: None (local processes), ``local-cluster`` or the address of a Dask
+    scheduler (tcp:// or tls://, a host and a port 1 to 65535); anything else is one line."""
+    if address is None or address == "local-cluster":
+        return address
+    m = re.fullmatch(rf"(?:tcp|tls)://{_HOST}:([0-9]{{1,5}})", address)
+    if m is None or not 1 <= int(m.group(1)) <= 65535:
+        raise ParamError("--scheduler", address, SCHEDULERS)
+    return address
+
+
+def check_outputs(spec: StudySpec, figures: set[str], study_file: str = "") -> None:
+    """``rank_by``, each failure's and each paper figure's output must be one of ``figures``
+    (the mechanism's study figures, ``LEVEL.KEY``); a study that ranks or counts by a figure
+    of the exact model must evaluate it (``exact`` not 0)."""
+    allowed = f"allowed one of the study's figures: {', '.join(sorted(figures))}"
+    named = [("rank_by", spec.rank_by), *((f"failures[{f.name}].output", f.output) for f in spec.failures),
+             *((f"paper.{i}.output", p.output) for i, p in enumerate(spec.paper))]
+    for where, name in named:
+        if name not in figures:
+            raise ParamError(where, name, allowed, study_file)
+    if spec.exact == 0 and spec.check_worst > 0 and spec.rank_by.startswith("exact."):
+        raise ParamError("check_worst", spec.check_worst, f"allowed 0 when exact = 0 (--exact 0): the worst "
+                         f"variants are ranked by {spec.rank_by}, a figure of the exact model", study_file)
 
 
 def load_spec(path: str | Path) -> StudySpec:

@@ -21,6 +21,7 @@ from gearcheck.params.common import fmt_bound, fmt_range
 MIN_TEETH = 7
 MAX_TEETH = 301
 TIP_GAP_MIN_MM = 0.05
+PITCH_MAX_MM = 500
 
 
 def _f(lo=None, hi=None, *, gt=None, lt=None, unit="", description=""):
@@ -47,7 +48,7 @@ class Ground(Section):
 class Chain(Section):
     """The articulated track read as a roller chain (ISO 606 symbols in brackets)."""
 
-    pitch_mm: float = _f(gt=0, hi=500, unit="mm", description="track pitch p")
+    pitch_mm: float = _f(gt=0, hi=PITCH_MAX_MM, unit="mm", description="track pitch p")
     sleeve_diameter_mm: float = _f(gt=0, hi=200, unit="mm", description="sleeve (roller) diameter dR [d1]")
     pin_diameter_mm: float = _f(gt=0, hi=100, unit="mm", description="track pin diameter d")
     sleeve_inner_width_mm: float = _f(gt=0, hi=500, unit="mm",
@@ -133,6 +134,8 @@ class Params(Section):
                 return iso606.seating_limits(v, z).seating_radius_min_mm * 2.0 < chord
 
             dr_max = fmt_bound(chord / 1.01, "upper", ok=leaves_tooth, strict=True)
+            if not float(dr_max) > 0:  # no sleeve fits: the pitch is what is out of range
+                raise _pitch_leaves_no_tooth(z, p, dr, chord)
             raise ParamError("chain.sleeve_diameter_mm", dr,
                              f"allowed < {dr_max} mm at z = {z}, p = {p:g} mm: seating circles "
                              f"(0.505·dR) of adjacent grooves {chord:.3f} mm apart must leave a tooth")
@@ -305,6 +308,22 @@ class Params(Section):
                              d + s.tip_over_pitch_mm)
         except iso606.ToothFormError as exc:  # not reachable inside the ISO limits; kept as a guard
             raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm, f"no valid tooth: {exc}") from None
+
+
+def _pitch_leaves_no_tooth(z: int, p: float, dr: float, chord: float) -> ParamError:
+    """The rejection of a pitch so small that no sleeve diameter leaves a tooth between adjacent
+    grooves: the pitch named, with the smallest pitch that leaves one for this sleeve. The groove
+    chord grows in proportion to the pitch."""
+    needed = iso606.seating_limits(dr, z).seating_radius_min_mm * 2.0
+
+    def leaves_tooth(v: float) -> bool:
+        return needed < iso606.groove_chord(iso606.every_other_tooth_pitch_diameter(v, z), z)
+
+    per_mm = iso606.groove_chord(iso606.every_other_tooth_pitch_diameter(1.0, z), z)
+    p_min = fmt_bound(needed / per_mm, "lower", ok=leaves_tooth, strict=True)
+    return ParamError("chain.pitch_mm", p,
+                      f"out of range: allowed >{p_min} to {PITCH_MAX_MM} mm at z = {z}, dR = {dr:g} mm: seating "
+                      f"circles (0.505·dR) of adjacent grooves {chord:.3g} mm apart must leave a tooth")
 
 
 def _largest_joining_offset(pitch_mm: float, sleeve_diameter_mm: float, track_width_mm: float) -> float:
