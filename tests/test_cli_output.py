@@ -47,7 +47,7 @@ def run_cli(argv: list[str]) -> tuple[int, str, str]:
 
 KNOWN = {"$schema", "title", "description", "type", "required", "properties", "additionalProperties", "$defs",
          "$ref", "const", "minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum", "minLength", "maxLength",
-         "pattern", "items", "maxItems", "minItems", "default", "unit", "anyOf"}
+         "pattern", "items", "maxItems", "minItems", "default", "unit", "anyOf", "enum"}
 TYPES = {
     "object": lambda v: isinstance(v, dict),
     "array": lambda v: isinstance(v, list),
@@ -71,6 +71,8 @@ def schema_errors(schema: dict, value, root: dict | None = None, path: str = "")
         return [f"{path}: matches no anyOf branch"]
     if "const" in schema and value != schema["const"]:
         return [f"{path}: {value!r} is not {schema['const']!r}"]
+    if "enum" in schema and value not in schema["enum"]:
+        return [f"{path}: {value!r} is not one of {schema['enum']!r}"]
     if "type" in schema and not TYPES[schema["type"]](value):
         return [f"{path}: {value!r} is not of type {schema['type']}"]
     if isinstance(value, dict):
@@ -313,7 +315,8 @@ def test_verdicts_wrapped_plain_and_coloured(track_check):
     result, name, folder = run.result, run.build.design.name, run.folder
     one_line = text(Screen(False, False, None), *verdicts_view(result, name, folder, Screen(False, False, None)))
     lines = one_line.splitlines()
-    assert lines[0].startswith(f"PASS {name}: {len(result.verdicts)}/{len(result.verdicts)} verdicts pass")
+    n, k = len(result.design_verdicts), len(result.self_checks)
+    assert lines[0].startswith(f"PASS {name}: design {n} of {n} verdicts pass; self-checks {k} of {k} pass")
     assert len(lines) == 1 + len(result.verdicts)
     for v, line in zip(result.verdicts, lines[1:], strict=True):  # grep finds a verdict and its measurement
         assert line == f"  {v.level.upper()}  {v.label}: {v.measured} [{v.evidence}]"
@@ -449,9 +452,9 @@ def test_build_json_and_open_the_folder(tmp_path, monkeypatch):
 
 
 def test_bad_input_with_json_is_one_line_on_stderr_and_nothing_on_stdout(tmp_path):
-    code, out, err = run_cli(["check", str(TRACK), "--json", "--set", "sprocket.teeth=48", "--out", str(tmp_path)])
+    code, out, err = run_cli(["check", str(TRACK), "--json", "--set", "sprocket.teeth=5", "--out", str(tmp_path)])
     assert code == 2 and out == ""
-    assert err.count("\n") == 1 and "sprocket.teeth = 48" in err
+    assert err.count("\n") == 1 and "sprocket.teeth = 5" in err
 
 
 # --------------------------------------------------------------------------------------------

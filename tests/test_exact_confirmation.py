@@ -26,9 +26,10 @@ def test_overlapping_worst_poses_are_measured_on_the_whole_solids(build_bodies):
         assert c.mesh_mm == 0.0
         assert c.brep_mm < 1e-9  # the exact solids intersect too
         assert math.isfinite(c.overlap_mm3) and c.overlap_mm3 > 0.0
-        assert c.agrees
+        assert c.agrees and c.contact == "overlapping"  # a zero distance, told apart from touching
+        assert c.figures()["contact"] == "overlapping"
     verdict = pipeline.confirmation_verdict(confirmations)
-    assert verdict.passed and "meshes overlap" in verdict.measured
+    assert verdict.passed and "meshes overlap" in verdict.measured and "solids overlapping" in verdict.measured
 
 
 def test_a_free_pose_that_disagrees_fails_the_verdict():

@@ -42,7 +42,7 @@ def test_sweep_csv_has_one_row_per_pose_and_all_columns():
 
 def test_html_shows_verdict_tables_and_inline_plots():
     page = render(sample(passed=False, confirmed=True), title="t", template="x.toml", build={})
-    assert "FAIL" in page and "0 of 1 verdicts pass" in page
+    assert "FAIL" in page and "design 0 of 1 verdicts pass" in page
     assert page.count("<svg") == 1 and "http://" not in page.split("<svg", 1)[0]
     assert ">3.4<" in page and "4.1000" in page and "a finding" in page
     assert "+0.00100" in page  # mesh − B-rep difference shown

@@ -18,13 +18,10 @@ from gearcheck.mechanisms.track import calc, layout, wear
 from gearcheck.params import ParamError
 
 TEMPLATE = "eod_track_drive"
-# The template's wear limit, found by bisection on e to a bracket of WEAR_BISECTION_TOL = 1e-6
-# (0.0001 % of pitch); the outline is sampled at 0.005 mm with the tip corner an exact vertex, and
-# the last flank chord's normal differs from the corner's by step/(2·re), which moves the limit by
-# r·step/(2·re)/R ≈ 9e-7 (0.00009 %). So the limit is known to about 0.0002 %: the bracket plus
-# the chord error.
-WEAR_LIMIT_PCT = 1.6564
-WEAR_LIMIT_TOL_PCT = 2e-4
+# The template's wear limit: the tip mode's closed form, 1.656423 %, which the bisection on the
+# exact arcs brackets to WEAR_BISECTION_TOL (1e-6 = 0.0001 % of pitch).
+WEAR_LIMIT_PCT = 1.656423
+WEAR_LIMIT_TOL_PCT = 1e-6
 
 
 @pytest.fixture(scope="module")
@@ -55,18 +52,13 @@ def closed_form_limit(gap, sleeve_radius_mm: float) -> float:
 
 
 def test_template_wear_limit_figure_and_closed_form(lay, limit):
-    """1.6564 % on the template, set by the sleeve riding up the flank to the tip corner; the
-    bisection bracket holds the closed form."""
-    assert limit.mode == "tip"
+    """1.656423 % on the template, set by the sleeve riding up the flank to the tip corner: the
+    closed form, held by the bisection bracket on the exact arcs."""
+    assert limit.mode == "tip" and limit.closed_form
     assert 100 * limit.limit == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
-    assert 0 < limit.fail_at - limit.limit <= wear.WEAR_BISECTION_TOL
-    gap, r = lay.sprocket.gap, lay.link.sleeve_radius_mm
-    exact = closed_form_limit(gap, r)
-    # the polyline's last flank chord (0.005 mm) turns its normal by step/(2·re) from the corner's,
-    # moving the sleeve centre by r·step/(2·re): ≈ 9e-7 in e at R = 117.3 mm
-    chord = r * wear.SEAT_OUTLINE_STEP_MM / (2.0 * gap.flank_radius_mm) / gap.pitch_radius_mm
-    assert limit.limit - chord <= exact <= limit.fail_at + chord
-    assert exact == pytest.approx(wear.tip_limit_closed_form(lay.sprocket.gap, lay.link.sleeve_radius_mm), abs=1e-12)
+    exact = closed_form_limit(lay.sprocket.gap, lay.link.sleeve_radius_mm)
+    assert limit.lo <= exact <= limit.fail_at and 0 < limit.fail_at - limit.lo <= wear.WEAR_BISECTION_TOL
+    assert limit.limit == pytest.approx(exact, abs=1e-12)
     # the short tooth (tip 0.2 mm above the pitch circle) tolerates less than ANSI's 3 % ceiling
     assert limit.limit < 0.03 and limit.ok
 
@@ -81,7 +73,11 @@ def test_seat_check_modes_and_sweep(lay, limit):
     assert limit.declared_sweep.min_plate_mm > 0.75  # the worn chain rides higher: the plate lifts away
     past = wear.seat_check(gap, r, limit.fail_at)
     assert not past.ok and past.mode == "tip"
-    assert past.contact_radius_mm == pytest.approx(gap.tip_radius_mm, abs=1e-4)
+    assert past.contact_radius_mm == pytest.approx(gap.tip_radius_mm, abs=1e-9)
+    # just below the closed form the contact is on the flank, just below the corner; just above, at it
+    below, above = wear.seat_check(gap, r, limit.limit - 1e-8), wear.seat_check(gap, r, limit.limit + 1e-8)
+    assert below.ok and 0 < gap.tip_radius_mm - below.contact_radius_mm < 1e-5
+    assert above.mode == "tip"
     # sleeve bottom above the tip circle: no contact at all before the tooth's centre line
     lifted = (gap.tip_radius_mm + r) / gap.pitch_radius_mm - 1.0 + 1e-3
     assert wear.seat_check(gap, r, lifted).mode == "jump"
@@ -89,21 +85,83 @@ def test_seat_check_modes_and_sweep(lay, limit):
         gap.seating_radius_mm - r, abs=1e-4)
 
 
-def test_windowed_nearest_is_the_whole_polyline_search_bit_for_bit(lay):
-    """The seat check's windowed search gives the whole polyline's distance and nearest point, to
-    the last bit, for sleeve centres lifted by any wear in the bracket, turned anywhere across the
-    groove, and for points off the pin circle."""
-    poly = wear.seat_polyline(lay.sprocket.gap)
-    outline = wear._Polyline(poly)
-    assert outline.windowed
-    rng = np.random.default_rng(7)
-    half = lay.sprocket.gap.half_pitch_angle_rad
-    for _ in range(400):
-        e, phi = rng.uniform(0.0, wear.WEAR_BRACKET_MAX), rng.uniform(-1.5 * half, 1.5 * half)
-        c = lay.sprocket.gap.pitch_radius_mm * (1.0 + e) * rng.uniform(0.9, 1.05) * np.array([np.cos(phi), np.sin(phi)])
-        d_all, q_all = wear._nearest(c, poly)
-        d_win, q_win = outline.nearest(c)
-        assert d_win == d_all and np.array_equal(q_win, q_all)
+def test_groove_distance_is_the_exact_arcs_one(lay):
+    """The seat check's distance (exact arcs) against an independent one: a dense polyline of the
+    outline (0.0005 mm chords), within its sagitta, for sleeve centres anywhere between the
+    groove's centre line and the next tooth's."""
+    from gearcheck.geometry import iso606
+
+    gap = lay.sprocket.gap
+    step = 5e-4
+    poly = iso606.tooth_gap_profile(gap, step)
+    a, b = poly[:-1], poly[1:]
+    rng = np.random.default_rng(3)
+    n = 300
+    phi = rng.uniform(0.0, gap.half_pitch_angle_rad, n)
+    rho = gap.pitch_radius_mm * rng.uniform(0.97, 1.06, n)
+    pts = np.column_stack([rho * np.cos(phi), rho * np.sin(phi)])
+    dist, q, _ = wear.groove_nearest(gap, pts)
+    e = b - a
+    for p, d, qq in zip(pts, dist, q, strict=True):
+        t = np.clip(((p - a) * e).sum(1) / (e * e).sum(1), 0.0, 1.0)
+        ref = np.hypot(*(a + t[:, None] * e - p).T).min()
+        assert abs(d - ref) <= step**2 / (8 * gap.seating_radius_mm) + 1e-12
+        assert np.hypot(*(qq - p)) == pytest.approx(d, abs=1e-12)
+
+
+# Designs across z, flank radius, seating angle, pitch and sleeve (the first two printed 3.96929–
+# 3.96938 % and 5.87349–5.87358 % before the seat check was made on the exact arcs, against the
+# closed forms 3.96999 % and 5.87467 %).
+INCH = ("chain.pitch_mm=25.4", "chain.sleeve_diameter_mm=6.35", "sprocket.seating_radius_mm=3.25")
+DESIGNS = {
+    "p25.4 z21 re25 a125": (*INCH, "sprocket.teeth=21", "sprocket.flank_radius_mm=25", "sprocket.seating_angle_deg=125"),
+    "z15 re20 a124": ("sprocket.teeth=15", "sprocket.flank_radius_mm=20", "sprocket.seating_angle_deg=124",
+                      "sprocket.initial_pitch_diameter_mm=70"),
+    "p28 z15 re20 a124": ("sprocket.teeth=15", "sprocket.flank_radius_mm=20", "sprocket.seating_angle_deg=124",
+                          "chain.pitch_mm=28"),
+    "p25.4 z15 re20 a124 tall": (*INCH, "sprocket.teeth=15", "sprocket.flank_radius_mm=20",
+                                 "sprocket.seating_angle_deg=124", "track_plate.tip_gap_mm=0.2",
+                                 "sprocket.tip_over_pitch_mm=0.7"),
+    "z49 re min a max": ("sprocket.flank_radius_mm=48.96", "sprocket.seating_angle_deg=138.16"),
+    "z31 re60 a121 tip 2": ("sprocket.teeth=31", "sprocket.flank_radius_mm=60", "sprocket.seating_angle_deg=121",
+                            "sprocket.tip_over_pitch_mm=2", "sprocket.initial_pitch_diameter_mm=150"),
+    "z50 even": ("sprocket.teeth=50",),
+}
+
+
+@pytest.mark.parametrize("name", list(DESIGNS))
+def test_wear_limit_is_the_closed_form_inside_an_honest_bracket(template, name):
+    """The reported limit is the tip mode's closed form (computed here, independently), and the
+    bracket the check reports holds it and is no wider than the tolerance it claims."""
+    lay = layout.track_layout(load_template(template, list(DESIGNS[name])).params)
+    gap, r = lay.sprocket.gap, lay.link.sleeve_radius_mm
+    w = wear.wear_limit(gap, lay.link, lay.wrap, 0.015)
+    exact = closed_form_limit(gap, r)
+    assert w.mode == "tip"
+    assert w.lo <= exact <= w.fail_at, (w.lo, exact, w.fail_at)
+    assert 0 < w.fail_at - w.lo <= w.tolerance == wear.WEAR_BISECTION_TOL
+    assert w.limit == pytest.approx(exact, rel=0, abs=1e-12) and w.closed_form
+    text = w.bracket_text()
+    assert "closed form" in text and f"{100 * w.lo:.6f}" in text and f"{100 * w.fail_at:.6f}" in text
+
+
+def test_exact_section_within_its_sagitta(lay):
+    """The worn-pitch sweep's polyline distances lie within its stated sagitta of a far finer
+    outline's (the bound the sweep mode's bracket is widened by)."""
+    from gearcheck.geometry.track_section import ExactSection
+
+    gap, link = lay.sprocket.gap, lay.link
+    coarse = ExactSection(gap, link)
+    fine = ExactSection(gap, link, step_mm=0.002)
+    for e in (0.0, 0.015):
+        c = wear.sweep_check(gap, link, lay.wrap, e, exact=coarse)
+        f = wear.sweep_check(gap, link, lay.wrap, e, exact=fine)
+        assert abs(c.min_sleeve_mm - f.min_sleeve_mm) <= coarse.sagitta_mm
+        assert abs(c.min_plate_mm - f.min_plate_mm) <= coarse.sagitta_mm
+    # certainly clear (by the sagitta) at the declared wear; not certainly clear with a margin past the least
+    assert wear.sweep_clear(gap, link, lay.wrap, 0.015, margin_mm=coarse.sagitta_mm)
+    least = wear.sweep_check(gap, link, lay.wrap, 0.015).min_sleeve_mm
+    assert not wear.sweep_clear(gap, link, lay.wrap, 0.015, margin_mm=least + 1e-6)
 
 
 def test_sweep_check_reads_the_sweep_table_as_computed(lay):

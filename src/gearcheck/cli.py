@@ -386,8 +386,12 @@ def cmd_study(args) -> int:
         if not f["variants"]:  # its output's level ran on no valid variant (--exact 0)
             print(f"  P({name}): not evaluated ({f['output']} on 0 variants): {f['label']}")
             continue
+        d = f["over_drawn"]
         print(f"  P({name}) = {100 * f['probability']:.3g} % [{100 * f['ci95_low']:.3g}, {100 * f['ci95_high']:.3g}] "
-              f"({f['failures']}/{f['variants']}): {f['label']}")
+              f"({f['failures']}/{f['variants']} valid variants): {f['label']}")
+        if d["rejected"]:
+            print(f"    over all drawn, the {d['rejected']} out of spec counted as failures: "
+                  f"{100 * d['probability']:.3g} % ({d['failures']}/{d['variants']})")
     for target, sens in s["sensitivity"].items():
         if not sens["variants"]:
             continue

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import math
 import logging
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -397,7 +398,7 @@ class _MeshPairs:
 def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
             progress: ProgressFactory = no_progress) -> list[Confirmation]:
     """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
-    from gearcheck.cad.confirm import exact_closest, exact_overlap_closest
+    from gearcheck.cad.confirm import contact_state, exact_closest, exact_overlap_closest
 
     by_name = {p.name: p for p in parts}
     meshes = _MeshPairs(bodies)
@@ -412,9 +413,13 @@ def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
                 brep, overlap, point_a, point_b = exact_overlap_closest(by_name, worst)
             else:
                 brep, point_a, point_b = exact_closest(by_name, worst, near=meshes.nearest_midpoint(worst))
+            contact, depth = "", math.nan
+            if brep <= bound:  # within the bound of zero: touching, overlapping, or clear?
+                contact, depth = contact_state(by_name, worst, brep, overlap, (point_a + point_b) / 2.0)
             out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
                                     worst.mesh_distance_mm, brep, bound, overlap,
-                                    tuple(float(v) for v in point_a), tuple(float(v) for v in point_b)))
+                                    tuple(float(v) for v in point_a), tuple(float(v) for v in point_b),
+                                    contact, depth))
             bar.update(1)
     keys = [c.key for c in out]
     if len(set(keys)) != len(keys):  # summary.json keeps one entry per key: none may be lost
@@ -432,8 +437,13 @@ def confirmation_verdict(confirmations: list[Confirmation], rule: Any = None) ->
     parts = []
     for c in confirmations:
         if c.meshes_overlap:
-            volume = "not computed" if c.overlap_mm3 != c.overlap_mm3 else f"{c.overlap_mm3:.4g} mm³"  # NaN
-            parts.append(f"{c.parts}: meshes overlap, exact distance {c.brep_mm:.2e} mm, common volume {volume}")
+            if c.overlap_mm3 == c.overlap_mm3:  # not NaN
+                measure = f"common volume {c.overlap_mm3:.4g} mm³"
+            else:
+                measure = (f"no Boolean gave a common volume; sampled penetration depth {c.depth_mm * 1e3:.2f} µm"
+                           if math.isfinite(c.depth_mm) else "common volume not computed")
+            parts.append(f"{c.parts}: meshes overlap, exact distance {c.brep_mm:.2e} mm, solids "
+                         f"{c.contact or 'in contact'} ({measure})")
         else:
             parts.append(f"{c.parts}: mesh {c.mesh_mm:.5f} vs B-rep {c.brep_mm:.5f} mm (bound {c.bound_mm:.4f})")
     unresolved = rule is not None and not rule.resolves

@@ -8,6 +8,8 @@ is a dataclass.
 
 from __future__ import annotations
 
+import math
+
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -16,6 +18,9 @@ Level = Literal["pass", "warn", "fail"]
 LEVELS: tuple[Level, ...] = ("pass", "warn", "fail")
 #: the kinds of evidence a verdict can rest on, most exact first
 EVIDENCE = ("exact B-rep", "exact model", "mesh sweep", "analytical model")
+# Verdicts about gearcheck's own evidence, not about the design: the mesh sweep agreeing with the
+# exact model, the worst poses confirmed on the exact B-rep. Counted apart from the design's.
+SELF_CHECKS = frozenset({"mesh_agrees_with_exact", "exact_confirmation"})
 
 
 @dataclass(frozen=True)
@@ -165,6 +170,11 @@ class Confirmation:
     # the exact solids' closest points at the pose (world, mm; one common point where they touch)
     point_a: tuple[float, ...] | None = None
     point_b: tuple[float, ...] | None = None
+    # where the exact distance is within the bound of zero: "clear", "touching" or "overlapping"
+    # (a zero distance alone cannot tell the last two apart: the common volume, else a sampled
+    # penetration depth, decides); "" where the distance is beyond the bound
+    contact: str = ""
+    depth_mm: float = math.nan  # the sampled penetration depth, where the volume could not be had
 
     @property
     def meshes_overlap(self) -> bool:
@@ -179,11 +189,15 @@ class Confirmation:
             return self.brep_mm <= self.bound_mm
         return abs(self.mesh_mm - self.brep_mm) <= self.bound_mm
 
-    def figures(self) -> dict[str, float]:
-        out = {"mesh_mm": self.mesh_mm, "brep_mm": self.brep_mm, "bound_mm": self.bound_mm,
-               "agrees": float(self.agrees)}
+    def figures(self) -> dict[str, float | str]:
+        out: dict[str, float | str] = {"mesh_mm": self.mesh_mm, "brep_mm": self.brep_mm, "bound_mm": self.bound_mm,
+                                       "agrees": float(self.agrees)}
         if self.overlap_mm3 is not None:
             out["overlap_mm3"] = self.overlap_mm3
+        if self.contact:
+            out["contact"] = self.contact
+        if math.isfinite(self.depth_mm):
+            out["depth_mm"] = self.depth_mm
         return out
 
 
@@ -255,3 +269,32 @@ class CheckResult:
     @property
     def failed(self) -> list[Verdict]:
         return [v for v in self.verdicts if not v.passed]
+
+    @property
+    def design_verdicts(self) -> list[Verdict]:
+        """The verdicts about the design (every one but gearcheck's self-checks)."""
+        return [v for v in self.verdicts if v.name not in SELF_CHECKS]
+
+    @property
+    def self_checks(self) -> list[Verdict]:
+        """gearcheck's checks of its own evidence (:data:`SELF_CHECKS`)."""
+        return [v for v in self.verdicts if v.name in SELF_CHECKS]
+
+    def counts(self) -> dict[str, dict[str, int]]:
+        """``{"design": {"pass": n, "warn": n, "fail": n}, "self_checks": {...}}``: how many
+        verdicts of each kind are at each level (what the banner, the CLI and summary.json say)."""
+        return {kind: {level: sum(v.level == level for v in group) for level in LEVELS}
+                for kind, group in (("design", self.design_verdicts), ("self_checks", self.self_checks))}
+
+    def count_text(self) -> str:
+        """"design 4 of 5 verdicts pass (1 with a warning); self-checks 2 of 2 pass": the one
+        phrase every place that counts verdicts uses."""
+        c = self.counts()
+        design, checks = c["design"], c["self_checks"]
+        n, k = sum(design.values()), sum(checks.values())
+        warned = f" ({design['warn']} with a warning)" if design["warn"] else ""
+        text = f"design {n - design['fail']} of {n} verdicts pass{warned}"
+        if k:
+            text += f"; self-checks {k - checks['fail']} of {k} pass" + (
+                f" ({checks['warn']} with a warning)" if checks["warn"] else "")
+        return text

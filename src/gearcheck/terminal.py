@@ -230,12 +230,9 @@ def badge(level: str, screen: Screen) -> Any:
 def _headline(result: CheckResult, name: str, folder: Path, screen: Screen) -> Any:
     from rich.text import Text
 
-    passed = sum(v.passed for v in result.verdicts)
-    warned = sum(v.level == "warn" for v in result.verdicts)
     line = Text()
     line.append_text(badge(result.level, screen))
-    line.append(f" {name}: {passed}/{len(result.verdicts)} verdicts pass"
-                f"{f', {warned} with a warning' if warned else ''}; report {folder / 'report.html'}")
+    line.append(f" {name}: {result.count_text()}; report {folder / 'report.html'}")
     return line
 
 

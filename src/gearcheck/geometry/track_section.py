@@ -131,13 +131,14 @@ class ExactSection:
         """The first of :meth:`link_distances` alone (the same figure)."""
         return self._sleeve(np.linalg.solve(sprocket_pose, link_pose)[:2, 3])
 
-    def clear_of_outline(self, sprocket_pose: np.ndarray, link_pose: np.ndarray) -> tuple[bool, bool]:
-        """Whether the sleeve, and the plate, certainly lie clear of the outline (distance > 0)
-        without measuring: wholly outside the circle through the outline's farthest vertex (its
-        chords lie inside it)."""
+    def clear_of_outline(self, sprocket_pose: np.ndarray, link_pose: np.ndarray,
+                         margin_mm: float = 0.0) -> tuple[bool, bool]:
+        """Whether the sleeve, and the plate, certainly lie clear of the outline (distance > 0, and
+        > ``margin_mm`` when that is positive) without measuring: wholly outside the circle through
+        the outline's farthest vertex (its chords, and the exact arcs, lie inside it) by that much."""
         rel = np.linalg.solve(sprocket_pose, link_pose)
         rot, origin = rel[:2, :2], rel[:2, 3]
-        beyond = self.outer_radius_mm + 1e-9
+        beyond = self.outer_radius_mm + max(margin_mm, 0.0) + 1e-9
         sleeve = float(np.hypot(*origin)) - self.link.sleeve_radius_mm > beyond
         axis = -(origin @ rot)  # the sprocket axis in the link frame
         x0, x1, y0, y1 = self.rect

@@ -28,6 +28,7 @@ def _plain(value):
 def summary_json(result: CheckResult) -> str:
     """``{section: {...summary..., "verdicts": {name: 1/0}, "verdict_levels": {name: "pass" |
     "warn" | "fail"}, "verdict_evidence": {name: text}, "verdict_pass": 1/0, "verdict_warnings": n,
+    "verdict_counts": {"design" | "self_checks": {level: n}},
     "exact_confirmation": {key: {mesh_mm, brep_mm, bound_mm}}}}`` with sorted keys."""
     body = dict(result.summary)
     body["verdicts"] = {v.name: int(v.passed) for v in result.verdicts}
@@ -35,6 +36,7 @@ def summary_json(result: CheckResult) -> str:
     body["verdict_evidence"] = {v.name: v.evidence for v in result.verdicts}
     body["verdict_pass"] = int(result.passed)
     body["verdict_warnings"] = sum(v.level == "warn" for v in result.verdicts)
+    body["verdict_counts"] = result.counts()
     if result.confirmations:
         body["exact_confirmation"] = {c.key: c.figures() for c in result.confirmations}
     return json.dumps({result.section: _plain(body)}, indent=2, sort_keys=True, allow_nan=False) + "\n"

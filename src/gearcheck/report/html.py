@@ -159,8 +159,7 @@ def _banner(result: CheckResult) -> str:
     level = result.level
     warned = [v for v in result.verdicts if v.level == "warn"]
     failed = [v for v in result.verdicts if v.level == "fail"]
-    head = (f"{level.upper()}: {sum(v.passed for v in result.verdicts)} of {len(result.verdicts)} verdicts pass"
-            f"{f' ({len(warned)} with a warning)' if warned else ''}")
+    head = f"{level.upper()}: {result.count_text()}"
     items = "".join(_claim(v) for v in [*failed, *warned])
     return f"<div class='banner {level}' id='summary'>{head}{f'<ul>{items}</ul>' if items else ''}</div>"
 

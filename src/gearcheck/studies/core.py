@@ -208,10 +208,17 @@ def summarise(spec: StudySpec, template: str, inputs: dict[str, np.ndarray], ev:
         seen = valid & np.isfinite(v)
         failed = seen & np.array([f.failed(x) if math.isfinite(x) else False for x in v])
         p, lo, hi = stats.wilson(int(failed.sum()), int(seen.sum()))
+        # over every variant drawn where the output was asked for: those the template rejects (out
+        # of spec) counted as failures of their own kind
+        out_of_spec = int((~valid).sum()) if seen.any() else 0
+        drawn, failed_or_rejected = int(seen.sum()) + out_of_spec, int(failed.sum()) + out_of_spec
+        pd, lod, hid = stats.wilson(failed_or_rejected, drawn)
         failures[f.name] = {"label": f.label, "output": f.output, "limit": f.below if f.below is not None else f.above,
                             "side": "below" if f.below is not None else "above", "variants": int(seen.sum()),
                             "failures": int(failed.sum()), "probability": p, "ci95_low": lo, "ci95_high": hi,
-                            "interval": "Wilson score, 95 %"}
+                            "interval": "Wilson score, 95 %", "over": "valid variants",
+                            "over_drawn": {"variants": drawn, "failures": failed_or_rejected, "rejected": out_of_spec,
+                                           "probability": pd, "ci95_low": lod, "ci95_high": hid}}
     targets = sorted({spec.rank_by, *(f.output for f in spec.failures)} & set(figures))
     sensitivity = {}
     for t in targets:

@@ -145,13 +145,19 @@ def render(spec: StudySpec, summary: dict, tab, *, study_file: str) -> str:
     level = "fail" if failing else "pass"
     parts.append(f"<div class='banner {level}'>{len(failing)} of {len(summary['failures'])} failure modes "
                  f"seen in {summary['valid']} valid variants</div>")
-    parts.append("<h2>Probability of each failure</h2><table><tr><th>failure</th><th>output</th><th>limit</th>"
-                 "<th>failures / variants</th><th>probability</th><th>95 % interval (Wilson)</th></tr>")
+    parts.append("<h2>Probability of each failure</h2><p class='meta'>Over the valid variants (those the "
+                 "template accepts: in spec), as the headline counts; beside it, over every variant drawn, the ones "
+                 "rejected as out of spec counted as failures of their own kind.</p><table><tr><th>failure</th>"
+                 "<th>output</th><th>limit</th><th>failures / valid variants</th><th>probability</th>"
+                 "<th>95 % interval (Wilson)</th><th>over all drawn (out of spec = failure)</th></tr>")
     for name, f in summary["failures"].items():
+        d = f.get("over_drawn") or {}
+        drawn = (f"{d['failures']} / {d['variants']}: {_pct(d['probability'])} ({_pct(d['ci95_low'])} – "
+                 f"{_pct(d['ci95_high'])})") if d.get("variants") else "—"
         parts.append(f"<tr><td>{html.escape(f['label'])} (<code>{name}</code>)</td><td><code>{html.escape(f['output'])}"
                      f"</code></td><td>{f['side']} {_fmt(f['limit'])}</td><td class='num'>{f['failures']} / "
                      f"{f['variants']}</td><td class='num p'>{_pct(f['probability'])}</td><td class='num'>"
-                     f"{_pct(f['ci95_low'])} – {_pct(f['ci95_high'])}</td></tr>")
+                     f"{_pct(f['ci95_low'])} – {_pct(f['ci95_high'])}</td><td class='num'>{drawn}</td></tr>")
     parts.append("</table>")
 
     parts.append("<h2>Inputs</h2><table><tr><th>input</th><th>template field</th><th>distribution</th>"

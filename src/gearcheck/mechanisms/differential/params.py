@@ -12,6 +12,7 @@ rejected before any CAD work.
 from __future__ import annotations
 
 import math
+from typing import Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
@@ -249,6 +250,20 @@ class Calibration(Section):
         return self.measured_backlash_total_min_arcmin is not None
 
 
+class Targets(Section):
+    """Requirements the design states (optional): each one given is a verdict. The paper requires
+    its unit to keep at least 10′ of total backlash cold; a template carries that here."""
+
+    cold_backlash_total_min_arcmin: float | None = Field(
+        default=None, ge=0.0, le=MEASURED_TOTAL_MAX_ARCMIN,
+        description="least total backlash (both sides) the design must keep at the cold design point, over the "
+                    "whole mesh cycle", json_schema_extra=_unit("arcmin"))
+    level: Literal["fail", "warn"] = Field(
+        default="fail", description="what falling short of a target is: a failed design (default) or a warning")
+    reason: str = Field(default="", max_length=400,
+                        description="why the level is what it is (shown with the verdict)")
+
+
 class Params(Section):
     """The whole template (less its top-level ``mechanism`` key)."""
 
@@ -259,6 +274,7 @@ class Params(Section):
     operating: Operating
     shim: Shim
     calibration: Calibration = Field(default_factory=Calibration)
+    targets: Targets = Field(default_factory=Targets)
     # the thinning solved from [calibration] by the validation (None: the template's [backlash])
     _thinning: cal.Thinning | None = PrivateAttr(default=None)
 

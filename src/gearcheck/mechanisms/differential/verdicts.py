@@ -41,8 +41,33 @@ def _play_evidence(data: SweepData, resolves: bool, states: str) -> str:
 def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
     data: SweepData = outcome.data
     resolves = bool(getattr(outcome, "mesh_resolves", True))
-    return [_warm(data, resolves), _cold(data, resolves), _operating(params, data, resolves), _storage(params, data),
-            _agreement(data)]
+    requirement = _cold_requirement(params, data, resolves)
+    return [_warm(data, resolves), _cold(data, resolves), *([requirement] if requirement else []),
+            _operating(params, data, resolves), _storage(params, data), _agreement(data)]
+
+
+def _cold_requirement(params, data: SweepData, resolves: bool) -> Verdict | None:
+    """The template's ``[targets] cold_backlash_total_min_arcmin``: the least total backlash (both
+    sides, twice the least play per side) over the whole cycle at the cold design point, from the
+    geometry where the meshes resolve it (the exact model beside it; the smaller decides), else
+    from the exact model. Below the target: the template's level (fail unless it says warn)."""
+    target = params.targets.cold_backlash_total_min_arcmin
+    if target is None:
+        return None
+    t, c = data.t, data.c
+    geom, exact = 2.0 * float(data.geom_min[t, c]), 2.0 * float(data.exact_min[t, c])
+    least = min(geom, exact) if resolves else exact
+    met = least >= target
+    cold = data.states[c][1]
+    why = f" ({params.targets.reason})" if params.targets.reason and not met else ""
+    return Verdict.graded(
+        "cold_backlash_target", f"cold total backlash ≥ {target:g}′ at {cold:g} °C (the design's target), shim "
+                                f"{shim_text(data.shims[t])} mm", "pass" if met else params.targets.level,
+        f"least cold total {geom:.3f}′ (geometry), exact {exact:.3f}′, required ≥ {target:g}′{why}",
+        {"geom_cold_backlash_total_min_arcmin": geom, "exact_cold_backlash_total_min_arcmin": exact,
+         "target_arcmin": float(target)},
+        evidence=_play_evidence(data, resolves, f"{cold:g} °C"),
+        shortfall=f"least cold total {least:.3f}′, required ≥ {target:g}′, short by {target - least:.3f}′{why}")
 
 
 def _warm(data: SweepData, resolves: bool) -> Verdict:

@@ -26,6 +26,7 @@ from gearcheck.mechanism import Assembly, SweepPlan, Task
 from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.mechanisms.steering import handover as ho
 from gearcheck.mechanisms.steering import meshes as ms
+from gearcheck.mechanisms.steering.ends import EndTop, end_tops
 from gearcheck.mechanisms.steering.meshes import PINION, RACK
 from gearcheck.results import SweepOutcome, WorstPose
 
@@ -77,6 +78,8 @@ class ModelFigures:
     contact_ratio: float = math.nan  # ε at the machined hS4 (eqs 1-2)
     stop_by: str = "G1's tip land grazes S2"  # past the stop, named by the pair that pushed last
     moving_at_end: bool = False  # the rack is still moving at the end of the towing swing
+    # the trimmed end teeth past the tooth that drove them last (hS6, hS8 against the stands, :mod:`.ends`)
+    ends: tuple[EndTop, ...] = ()
 
     @classmethod
     def of(cls, g: RackPinionGeometry, tow: an.Towing) -> ModelFigures:
@@ -86,7 +89,8 @@ class ModelFigures:
                    deg(tow.reengage_rad), deg(min(an.continuous_towing_angle(g), an.continuous_power_angle(g))),
                    deg(an.continuous_power_angle(g)), deg(an.phi_towing_conjugate_end(g, g.sector_first_tooth)),
                    towing.angle_deg, towing.event, power.angle_deg, power.event,
-                   an.contact_ratio(g, g.hS4_mm), stop_phrase(g, tow.last_pusher), math.isnan(tow.disengage_rad))
+                   an.contact_ratio(g, g.hS4_mm), stop_phrase(g, tow.last_pusher), math.isnan(tow.disengage_rad),
+                   end_tops(g, tow))
 
 
 @dataclass(frozen=True)

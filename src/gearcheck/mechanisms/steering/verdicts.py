@@ -1,13 +1,16 @@
 """The steering check's claims, from the sweep's figures of both directions: continuous drive to
 the target (towing and power mode, through every hand-over: the least of the exact model and the
 mesh), the contact ratio at the machined hS4, the rack stopping and standing in towing, no
-interference past the stop, on the return swing or anywhere, and the mesh towing curve agreeing
-with the exact push model."""
+interference past the stop (the mesh, and the trimmed tops S2–S6 / S4–S8 against the tip lands
+where the rack really stands: exact model, :mod:`.ends`), on the return swing or anywhere, and the
+mesh towing curve agreeing with the exact push model."""
 
 from __future__ import annotations
 
 import math
 
+from gearcheck.mechanisms.steering.ends import EndTop
+from gearcheck.mechanisms.steering.push import TRAVEL_TOL_MM
 from gearcheck.mechanisms.steering.sweep import SteeringSweep, drive_figures, sign, still_moving
 from gearcheck.results import SweepOutcome, Verdict
 
@@ -54,13 +57,86 @@ def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
                    swept + "; the pick-up bracketed by bisection on the pinion angle",
                    shortfall=_clearance_shortfall(ret, tol) if not _ok(ret, lambda c: c >= -tol) else
                    "the return swing does not pick the rack up within the swing (no re-engage angle)"),
-        Verdict.of("no_interference_anywhere", "no interference at any pose (towing both ways, power mode)",
-                   _ok(clear, lambda c: c >= -tol),
-                   f"min signed clearance {_num(min(clear), 5)} mm ≥ −{tol:.3f} mm over {poses} poses",
-                   _finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol}), swept,
-                   shortfall=_clearance_shortfall(clear, tol)),
+        _anywhere(data, clear, poses, swept),
         _mesh_agrees(data),
     ]
+
+
+def _anywhere(data: SteeringSweep, clear: list[float], poses: int, swept: str) -> Verdict:
+    """Interference at any swept pose (mesh sweep), and a trimmed end tooth caught by its tip tooth
+    (exact model, :mod:`.ends`): either decides."""
+    tol = data.tol
+    mesh_ok = _ok(clear, lambda c: c >= -tol)
+    caught = [e for e in data.model.ends if not e.clears]
+    measured = f"min signed clearance {_num(min(clear), 5)} mm ≥ −{tol:.3f} mm over {poses} poses"
+    figures = _finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol})
+    shortfall = _clearance_shortfall(clear, tol) if not mesh_ok else ""
+    evidence = swept
+    if caught:
+        measured += "; " + "; ".join(_end_measured(e) for e in caught)
+        figures.update(_end_figures(data.model.ends))
+        shortfall = "; ".join(filter(None, [shortfall, *(_end_shortfall(e) for e in caught)]))
+        evidence = f"{END_EVIDENCE}; {swept}"
+    return Verdict.of("no_interference_anywhere", "no interference at any pose (towing both ways, power mode)",
+                      mesh_ok and not caught, measured, figures, evidence, shortfall=shortfall)
+
+
+# The exact model's rule for the trimmed end teeth (docs/steering.md, "Trimmed tops past the stop").
+END_EVIDENCE = ("exact model (the stands of the push model past S2 and S4 and at the stop; each trimmed top "
+                "against the region its tip tooth sweeps while the rack stands; the tooth pair's overlap on "
+                "both towing swings)")
+
+
+def _end_where(e: EndTop) -> str:
+    """Where the rack stands while the tip land sweeps over the top, in words."""
+    s = e.stand
+    if s is None:
+        return "no stand of the rack limits it"
+    if s.why == "the rack stops for good":
+        stand = f"the rack stops for good at {s.travel_mm:.3f} mm at {s.start_deg:.3f}°"
+    elif s.final:
+        stand = f"{s.why} at {s.start_deg:.3f}° and the rack stops there for good at {s.travel_mm:.3f} mm"
+    else:
+        stand = (f"{s.why} at {s.start_deg:.3f}° and the rack stands at {s.travel_mm:.3f} mm until it is picked "
+                 f"up again at {s.end_deg:.3f}°")
+    if e.on_circle:
+        return (f"{stand}, with {e.corner} on {e.tooth}'s {e.circle} circle, so the top must lie under the "
+                f"circle's tangent at {e.corner}")
+    where = "outside" if e.corner_gap_mm > 0 else "inside"
+    return f"{stand}, with {e.corner} {abs(e.corner_gap_mm):.3f} mm {where} {e.tooth}'s {e.circle} circle"
+
+
+def _end_measured(e: EndTop) -> str:
+    name = e.field.removeprefix("trim.").removesuffix("_mm")
+    limit = f"up to {name} = {e.limit_mm:.3f} mm" if math.isfinite(e.limit_mm) else f"at no {name}"
+    text = (f"exact model: {name} = {e.height_mm:g} mm; {e.tooth}'s tip land clears the {e.corner}–{e.far} top "
+            f"{limit}: {_end_where(e)}")
+    if e.overlap_mm > 0.0:
+        text += (f"; {e.tooth} cuts {e.overlap_mm:.4f} mm into the {e.rack_tooth} rack tooth at +{e.overlap_deg:.3f}° "
+                 f"(push model, {e.overlap_swing} swing)")
+    return text
+
+
+def _end_shortfall(e: EndTop) -> str:
+    name = e.field.removeprefix("trim.").removesuffix("_mm")
+    parts = []
+    if not math.isfinite(e.limit_mm):
+        parts.append(f"no {name} clears {e.tooth}'s tip land ({_end_where(e)})")
+    elif e.height_mm > e.limit_mm:
+        parts.append(f"{name} = {e.height_mm:.3f} mm, allowed ≤ {e.limit_mm:.3f} mm ({e.tooth}'s tip land over the "
+                     f"{e.corner}–{e.far} top), {e.height_mm - e.limit_mm:.3f} mm too high")
+    if e.overlap_mm > TRAVEL_TOL_MM:
+        parts.append(f"{e.tooth} cuts {e.overlap_mm:.4f} mm into the {e.rack_tooth} rack tooth ({e.overlap_swing} "
+                     f"swing, +{e.overlap_deg:.3f}°), allowed ≤ {TRAVEL_TOL_MM:g} mm")
+    return "; ".join(parts)
+
+
+def _end_figures(tops) -> dict:
+    out: dict = {}
+    for e in tops:
+        name = e.field.removeprefix("trim.").removesuffix("_mm")
+        out.update({f"{name}_mm": e.height_mm, f"{name}_limit_mm": e.limit_mm, f"{name}_overlap_mm": e.overlap_mm})
+    return _finite(out)
 
 
 def _clearance_shortfall(values: list[float], tol: float) -> str:
@@ -242,8 +318,23 @@ def _rack_stops(data: SteeringSweep, max_deg: float) -> Verdict:
 
 
 def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
+    """Past the disengage: the mesh sweep past the stop, and each trimmed end tooth once its tip
+    tooth lets go of its drive corner (exact model, :mod:`.ends`); either decides."""
     plus, minus, tol = data.plus, data.minus, data.tol
     label = f"towing: no interference past the disengage ({data.model.stop_by})"
+    caught = [e for e in data.model.ends if not e.clears]
+    if caught:
+        past = [plus.get("min_clearance_past_disengage_mm", math.nan),
+                minus.get("min_clearance_past_disengage_mm", math.nan)]
+        mesh = (f"mesh sweep past the stop: min signed clearance {_num(min(past), 5)} mm"
+                if _ok(past, lambda c: True) else "mesh sweep: no stop within the swing")
+        return Verdict.of(
+            "no_interference_past_disengage", label, False,
+            "; ".join(_end_measured(e) for e in caught) + f"; {mesh}",
+            {**_end_figures(data.model.ends), **_finite({"min_signed_clearance_mm": min(past),
+                                                         "contact_tolerance_mm": tol})},
+            f"{END_EVIDENCE}; {swept}",
+            shortfall="; ".join(_end_shortfall(e) for e in caught))
     if _moving(data):
         return Verdict.graded("no_interference_past_disengage",
                               "towing: no interference past the disengage", "warn",
@@ -258,7 +349,7 @@ def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
         _ok(past, lambda c: c >= -tol),
         f"min signed clearance {_num(min(past), 5)} mm ≥ −{tol:.3f} mm; contact reached "
         f"{_num(max(shifts), 5)} mm of rack shift away",
-        _finite({"min_signed_clearance_mm": min(past), "contact_tolerance_mm": tol,
-                 "contact_shift_mm": max(shifts)}),
+        {**_finite({"min_signed_clearance_mm": min(past), "contact_tolerance_mm": tol,
+                    "contact_shift_mm": max(shifts)}), **_end_figures(data.model.ends)},
         swept + "; the closest pose past the stop confirmed on the exact B-rep",
         shortfall=_clearance_shortfall(past, tol))

@@ -1,5 +1,6 @@
-"""Track-drive sprocket of a bomb-disposal robot: ISO 606 groove form, every other tooth engaging,
-short tooth under the track plate; drive force, pin shear and crush stress.
+"""Track-drive sprocket of a bomb-disposal robot for the paper's articulated track (grooves every
+half pitch): ISO 606 groove form, every other tooth engaging, short tooth under the track plate;
+drive force, pin shear and crush stress.
 
 ``calc(params)`` returns the figures beside the paper's printed values (``PAPER``); the model and
 its readings are in :mod:`.analysis` and docs/track.md. The mechanism itself (assembly, CAD hook,
@@ -113,10 +114,12 @@ def _geometry(params: Params, add):
     chord = iso606.groove_chord(d, z)
     z_up = odd_round_up(z_initial)
     z_note = (f"rounded up to the odd z = {z}" if z == z_up
-              else f"template z = {z}, not the odd round-up {z_up} of this estimate")
+              else f"template z = {z}{'' if z % 2 else ' (even)'}, not the odd round-up {z_up} of this estimate")
     add("teeth_for_initial_pitch_diameter", f"z for d = {sp.initial_pitch_diameter_mm:g} mm (eq. 6 inverted)",
         z_initial, "", z_note, 2)
-    add("pitch_diameter_mm", "pitch diameter d = p/sin(360°/z)", d, "mm", "every other tooth engages", 2)
+    add("pitch_diameter_mm", "pitch diameter d = p/sin(360°/z)", d, "mm",
+        "every other tooth engages" + ("" if z % 2 else f"; even z: the same {z // 2} teeth take every engagement"),
+        2)
     add("root_diameter_mm", "root diameter df = d − dR", df, "mm", digits=2)
     add("tip_diameter_mm", "tip diameter de = d + tip rule", de, "mm",
         f"short tooth: d + {sp.tip_over_pitch_mm:g} mm", 2)
@@ -180,8 +183,8 @@ def _wear(params: Params, add, gap) -> None:
     limit = 100.0 * wear.tip_limit_closed_form(gap, params.chain.sleeve_diameter_mm / 2.0)
     add("wear_elongation_pct", "declared chain wear (pitch growth)", declared, "%", "chain.wear_elongation_pct")
     add("wear_limit_tip_pct", "wear at which the flank contact reaches the tip corner", limit, "%",
-        f"{'pass' if declared <= limit else 'FAIL'}: closed form; `check` bisects the exact 2-D model "
-        "(tip, jump and worn-sweep modes)", 4)
+        f"{'pass' if declared <= limit else 'FAIL'}: closed form; `check` brackets it on the exact arcs and "
+        "adds the jump and worn-sweep modes", 4)
 
 
 def _loads(params: Params, add, d: float) -> tuple[float, float]:

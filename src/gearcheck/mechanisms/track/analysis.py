@@ -89,7 +89,8 @@ def hertz_line_contact(
 
 def chain_advance_per_turn_mm(pitch_mm: float, teeth: int) -> float:
     """Chain travel per sprocket revolution, z·p/2: every other tooth engages, so a link spans
-    two of the z grooves and z/2 links pass per turn (an odd z averages over two turns). Not π·d:
+    two of the z grooves and z/2 links pass per turn (exactly, for an even z; an odd z averages
+    over two turns, the pins taking the other set of grooves on the second). Not π·d:
     the pins move on the pin circle d but the chain between them is a chord, shorter than the arc
     by the factor sin(2π/z)/(2π/z) (0.27 % at z = 49)."""
     return teeth * pitch_mm / 2.0

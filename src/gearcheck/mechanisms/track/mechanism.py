@@ -19,12 +19,14 @@ if TYPE_CHECKING:
 
 
 class TrackDrive(Mechanism):
-    """Track-drive sprocket of a bomb-disposal robot: ISO 606 groove form, every other tooth
-    engaging, a wrapped segment of track links (docs/track.md, docs/sprocket_cad.md)."""
+    """Track-drive sprocket of a bomb-disposal robot, for the paper's articulated track (grooves
+    every half pitch): ISO 606 groove form, every other tooth engaging, a wrapped segment of track
+    links (docs/track.md, docs/sprocket_cad.md)."""
 
     name = "track"
     section = "track"
-    title = "track drive sprocket: ISO 606 form, every other tooth engaging"
+    title = ("track drive sprocket for the paper's articulated track (grooves every half pitch): ISO 606 form, "
+             "every other tooth engaging")
     Params = TrackParams
     mesh_tol_mm = MESH_TOL_MM
     template = "eod_track_drive.toml"

@@ -1,11 +1,13 @@
 """Template model of the track-drive sprocket: every input of the paper, nothing derived.
 
-Field ranges are physical limits; the cross-field rules (odd tooth count, a tooth left between
-adjacent grooves, the ISO 606 seating limits, a tip land left under the tip circle, widths that
-fit) live in :class:`Params` and each raise one :class:`ParamError` naming the field, the value
-and the allowed range computed from the other inputs. Last, the model builds the layout the CAD
+Field ranges are physical limits; the cross-field rules (a tooth left between adjacent grooves,
+the ISO 606 seating limits, a tip land left under the tip circle, widths that fit) live in
+:class:`Params` and each raise one :class:`ParamError` naming the field, the value and the allowed
+range computed from the other inputs. Last, the model builds the layout the CAD
 builds from (:mod:`.layout`: sprocket spec with its bore, link section, default chain wrap), so a
-set the CAD could not build is rejected before any CAD work.
+set the CAD could not build is rejected before any CAD work. An even tooth count is valid (every
+other tooth engaging works with any z); `gearcheck check` warns about it (verdict
+``odd_tooth_count``).
 """
 
 from __future__ import annotations
@@ -113,10 +115,6 @@ class Params(Section):
     def _cross_checks(self) -> Params:
         s, c = self.sprocket, self.chain
         z, p, dr = s.teeth, c.pitch_mm, c.sleeve_diameter_mm
-        if z % 2 == 0:
-            raise ParamError("sprocket.teeth", z,
-                             f"allowed odd numbers {MIN_TEETH} to {MAX_TEETH}: with every other tooth "
-                             "engaging, an odd z lets each tooth take its turn (wear alternates)")
         if not c.pin_diameter_mm < dr:
             raise ParamError("chain.pin_diameter_mm", c.pin_diameter_mm,
                              f"allowed < sleeve diameter {fmt_bound(dr, 'upper', None)} mm (the pin runs inside the "
@@ -236,16 +234,14 @@ class Params(Section):
                 return layout.hub_radius_mm(d, s.seating_radius_mm) > bore / 2.0
 
             # (the chain wrap, checked next, needs enough teeth too: the least count passes both)
-            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if fits(n) and _wrap_fits(n, p)), None)
-            allowed = f"allowed odd {z_min} to {MAX_TEETH}" if z_min else f"no odd count up to {MAX_TEETH} allowed"
+            allowed = _allowed_teeth(z, lambda n: fits(n) and _wrap_fits(n, p))
             raise ParamError("sprocket.teeth", z,
                              f"{allowed} at p = {p:g} mm: the {bore:g} mm shaft bore must lie under the "
                              f"middle groove floor, {depth:g} mm below the root circle (sprocket too small)") from None
         try:
             layout.default_wrap(z, p)
         except ValueError as exc:
-            z_min = next((n for n in range(z + 2, MAX_TEETH + 1, 2) if _wrap_fits(n, p)), None)
-            allowed = f"allowed odd {z_min} to {MAX_TEETH}" if z_min else f"no odd count up to {MAX_TEETH} allowed"
+            allowed = _allowed_teeth(z, lambda n: _wrap_fits(n, p))
             raise ParamError("sprocket.teeth", z,
                              f"{allowed}: the chain segment built at θ = 0 "
                              f"({layout.DEFAULT_WRAP_ANGLE_DEG:g}° wrap plus {layout.DEFAULT_RUN_LINKS} links on "
@@ -349,6 +345,18 @@ def _joins(pitch_mm: float, sleeve_diameter_mm: float, plate_offset_mm: float, t
     except ValueError:
         return False
     return True
+
+
+def _allowed_teeth(z: int, fits) -> str:
+    """The tooth counts above ``z`` that ``fits`` (more teeth: a larger sprocket): the least odd
+    one, and the least even one where that is smaller (even z is accepted with a warning: the same
+    z/2 teeth take every engagement)."""
+    odd = next((n for n in range(z + 1, MAX_TEETH + 1) if n % 2 and fits(n)), None)
+    even = next((n for n in range(z + 1, MAX_TEETH + 1) if not n % 2 and fits(n)), None)
+    if odd is None:
+        return f"no count up to {MAX_TEETH} allowed" if even is None else f"allowed even {even} to {MAX_TEETH - 1}"
+    also = f" (or even {even} up, with the even-z warning)" if even is not None and even < odd else ""
+    return f"allowed odd {odd} to {MAX_TEETH}{also}"
 
 
 def _wrap_fits(teeth: int, pitch_mm: float) -> bool:

@@ -89,8 +89,8 @@ def _wear_notes(d: TrackSweep) -> list[str]:
                    f"{d.model.gap.tip_radius_mm:.4f} mm)" if seat.ok else f"the sleeve fails: {MODE_TEXT[seat.mode]}")
     return [
         f"Chain wear: every link pitch p·(1 + e), the sprocket unchanged, the pins on the larger circle "
-        f"R·(1 + e). Limit {100 * w.limit:.4f} % (bisection bracket {100 * w.limit:.5f}–"
-        f"{finite(100 * w.fail_at):.5f} %; {MODE_TEXT[w.mode]}); declared {100 * w.declared:.3f} %: "
+        f"R·(1 + e). Limit {100 * w.limit:.4f} % ({w.bracket_text()}; {MODE_TEXT[w.mode]}); declared "
+        f"{100 * w.declared:.3f} %: "
         f"{at_declared}; the worn chain re-wrapped at p' and swept over {sweep.poses} poses × {sweep.links} links "
         f"keeps sleeves ≥ {finite(sweep.min_sleeve_mm):.4f} mm and plates ≥ {finite(sweep.min_plate_mm):.4f} mm "
         "from the outline. The exact 2-D model decides the seat (where the driving-flank contact lies); "

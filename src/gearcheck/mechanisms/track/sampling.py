@@ -9,9 +9,9 @@ from gearcheck.mechanisms.sampling import Draw, _int_knob, _knob
 
 
 def sample_track(data: dict, draw: Draw) -> None:
-    """Redraw every knob of a track template body in place: pitch, tooth count (odd, sometimes
-    not), sleeve and the ISO 606 form inside its limits, widths and rows, the tip gap and its
-    window, loads, materials and strengths."""
+    """Redraw every knob of a track template body in place: pitch, tooth count (mostly odd,
+    sometimes even: valid, with the check's warning), sleeve and the ISO 606 form inside its
+    limits, widths and rows, the tip gap and its window, loads, materials and strengths."""
     r = data["robot"]
     r["mass_kg"] = _knob(draw, 5.0, 2000.0, 1)
     r["speed_m_s"] = _knob(draw, 0.1, 5.0, 2)

@@ -17,8 +17,7 @@ def exact_row(model: TrackModel) -> dict[str, float]:
     section = ExactSection(model.gap, model.link)
     new = track_wear.sweep_check(model.gap, model.link, model.wrap, 0.0, exact=section)
     worn = track_wear.sweep_check(model.gap, model.link, model.wrap, model.wear_elongation, exact=section)
-    poly = track_wear.seat_polyline(model.gap)
-    seat = track_wear.seat_check(model.gap, model.link.sleeve_radius_mm, model.wear_elongation, poly)
+    seat = track_wear.seat_check(model.gap, model.link.sleeve_radius_mm, model.wear_elongation)
     tip_limit = track_wear.tip_limit_closed_form(model.gap, model.link.sleeve_radius_mm)
     jumps = not (seat.ok and worn.ok)
     return {

@@ -484,7 +484,10 @@ def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: f
         "wear_limit_mode": w.mode_code,
         "wear": {
             "limit_pct": 100.0 * w.limit,
+            "bracket_lo_pct": 100.0 * w.lo,
             "fail_at_pct": finite(100.0 * w.fail_at),
+            "limit_is_closed_form": int(w.closed_form),
+            "tip_closed_form_pct": 100.0 * w.tip_closed_form,
             "bisection_tolerance_pct": 100.0 * w.tolerance,
             "declared_pct": 100.0 * w.declared,
             "limit_mode": w.mode_code,

@@ -1,7 +1,7 @@
 """The track drive's verdicts: no interference, the seated tip gap inside the paper's window, the
 least tip-to-plate distance over the sweep, contact proven from both sides, the declared chain
-wear within the limit at which a link first fails to seat, and the mesh sweep against the exact
-2-D model."""
+wear within the limit at which a link first fails to seat, a warning for an even tooth count (only
+then), and the mesh sweep against the exact 2-D model."""
 
 from __future__ import annotations
 
@@ -86,6 +86,7 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                     "tolerance_mm": d.contact_tol, "bound_mm": bound},
                    evidence="mesh sweep (FCL: pushed by the gap ∓ tolerance)", shortfall=proof_short),
         *_wear_verdicts(d),
+        *tooth_count_verdicts(model.gap.teeth),
         Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with the exact 2-D model at every pose and link",
                    agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm"
                    + ("" if d.worn_mesh is None else f" (worn chain: {worn_dev:.4f} mm)") + f", bound {bound:.3f} mm",
@@ -107,6 +108,26 @@ def _proof_shortfall(name: str, proof, bound: float, tol: float) -> str:
             f"{abs(proof.contact_mm - proof.measured_mm):.5f} mm, allowed ≤ {bound:.4f} mm")
 
 
+# The paper's mechanism, named where a message depends on it.
+SCOPE = "the paper's articulated track: grooves every half pitch"
+
+
+def tooth_count_verdicts(teeth: int) -> list[Verdict]:
+    """An even z works (the wrap, the CAD and the sweep take any z) but only half the teeth ever
+    engage: a warning, not a failure. None for an odd z."""
+    if teeth % 2:
+        return []
+    half = teeth // 2
+    return [Verdict.graded(
+        "odd_tooth_count", "odd tooth count: every tooth takes its turn to engage", "warn",
+        f"even z = {teeth} ({SCOPE}): every other tooth engaging means the same z/2 = {half} teeth take every "
+        "engagement; the other half never wear — an odd z lets each tooth take its turn",
+        {"teeth": teeth, "engaging_teeth": half},
+        evidence="analytical model (the tooth count; pins two grooves apart)",
+        shortfall=f"z = {teeth} even: {half} teeth take every engagement, the other {half} none; an odd z "
+                  f"({teeth - 1} or {teeth + 1}) shares it among all teeth")]
+
+
 def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
     """The declared chain wear within the limit at which a link first fails to seat."""
     w = d.wear
@@ -126,10 +147,11 @@ def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
     return [Verdict.of(
         "chain_wear_within_limit", "declared chain wear ≤ the elongation at which a link first fails to seat",
         w.ok and (m is None or m.collisions == 0),
-        f"declared {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % ({MODE_TEXT[w.mode]}; bisection "
-        f"±{100 * w.tolerance:.4f} %); at the declared wear the sleeve {seat}, {sweep} "
+        f"declared {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % ({MODE_TEXT[w.mode]}; "
+        f"{w.bracket_text()}); at the declared wear the sleeve {seat}, {sweep} "
         f"(exact 2-D model){mesh}",
         {"wear_declared_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
          "wear_limit_mode": w.mode_code},
-        evidence="exact model (2-D section, bisection on the elongation); mesh sweep at the declared wear",
+        evidence="exact model (2-D section: exact arcs, closed form or bisection on the elongation); mesh sweep at "
+                 "the declared wear",
         shortfall=short)]

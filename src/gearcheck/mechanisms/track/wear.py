@@ -19,8 +19,11 @@ Under the drive the tooth pushes each sleeve tangentially, so a raised sleeve is
    the outline at every pose (the exact 2-D distances ≥ 0): no plate meets a tip, no sleeve
    swinging in hits a tooth.
 
-The limit is the least e at which one of these fails, found by bisection on e (each predicate is
-monotonic in e over the bracket: a larger pitch raises every pin further).
+The limit is the least e at which one of these fails (each predicate is monotonic in e: a larger
+pitch raises every pin further). Checks 1 and 2 are made on the exact arcs of the tooth form (no
+polyline); check 1 has a closed form, which is the limit in that mode, and a bisection on e brackets
+it. Check 3 is made on the outline polyline of :class:`ExactSection`, within its chord sagitta of
+the arcs, and its bracket is widened by that (see :func:`wear_limit`).
 """
 
 from __future__ import annotations
@@ -39,10 +42,6 @@ from gearcheck.geometry.track_section import ExactSection
 WEAR_BRACKET_MAX = 0.25
 # Bisection stops when the bracket on e is this narrow (fraction: 1e-6 = 0.0001 % of pitch).
 WEAR_BISECTION_TOL = 1e-6
-# Outline sampling of the seat check (every arc end, hence the tip corner, is an exact vertex).
-SEAT_OUTLINE_STEP_MM = 0.005
-# A contact point this close to the tip circle counts as at the tip corner (mm).
-TIP_CONTACT_TOL_MM = 1e-6
 # Sweep of the worn chain: sprocket angles per engagement cycle (coarser than the mesh sweep's 60:
 # the exact model is continuous, and at the limit the seat check, not the sweep, decides).
 WORN_SWEEP_STEPS_PER_CYCLE = 30
@@ -65,144 +64,99 @@ class SeatResult:
     shift_deg: float  # rotation about the axis from the groove line to the first contact
 
 
-def _outline_near_groove(gap: iso606.ToothGap, step_mm: float) -> np.ndarray:
-    """Three pitches of the outline, grooves −1, 0, +1 (groove 0 centred on polar angle 0), as one
-    open polyline in increasing polar angle (the pitch profile of :func:`iso606.tooth_gap_profile`
-    turned by ∓360°/z)."""
-    one = iso606.tooth_gap_profile(gap, step_mm)
-    pieces = []
-    for k in (-1, 0, 1):
-        a = 2.0 * math.pi * k / gap.teeth
-        rot = np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
-        pieces.append((one if k == 1 else one[:-1]) @ rot.T)
-    return np.vstack(pieces)
+# The pieces of the outline between groove 0's centre line (polar angle 0) and the next tooth's
+# centre line (π/z), in order: the seating arc's +y half, the driving flank, the tip land.
+SEAT, FLANK, LAND = 0, 1, 2
+# Sleeve-centre angles scanned for the first contact before it is bisected (60 halvings).
+SEAT_SCAN_STEPS = 400
+SEAT_BISECTIONS = 60
 
 
-def seat_polyline(gap: iso606.ToothGap) -> np.ndarray:
-    """The groove's outline for :func:`seat_check` (made once per gap, reused across elongations)."""
-    return _outline_near_groove(gap, SEAT_OUTLINE_STEP_MM)
+def _arc_nearest(points: np.ndarray, centre: np.ndarray, radius: float, a0: float, span: float,
+                 end0: np.ndarray, end1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Distance from each point (N, 2) to the exact arc of ``radius`` about ``centre`` running
+    counter-clockwise from angle ``a0`` through ``span`` (ends ``end0``, ``end1``, the construction's
+    exact vertices), the nearest point on it, and whether that point is the far end ``end1``."""
+    v = points - centre
+    rho = np.hypot(v[:, 0], v[:, 1])
+    on_arc = np.mod(np.arctan2(v[:, 1], v[:, 0]) - a0, 2.0 * math.pi) <= span
+    d0 = np.hypot(*(points - end0).T)
+    d1 = np.hypot(*(points - end1).T)
+    far = ~on_arc & (d1 <= d0)
+    dist = np.where(on_arc, np.abs(rho - radius), np.minimum(d0, d1))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q_arc = centre + radius * v / rho[:, None]
+    q = np.where(on_arc[:, None], q_arc, np.where(far[:, None], end1, end0))
+    return dist, q, far
 
 
-def _nearest(point: np.ndarray, poly: np.ndarray) -> tuple[float, np.ndarray]:
-    """Distance from ``point`` to the open polyline ``poly`` and the nearest point on it (the
-    first nearest segment's, in polyline order)."""
-    a, b = poly[:-1], poly[1:]
-    e = b - a
-    t = np.clip(((point - a) * e).sum(axis=1) / np.maximum((e * e).sum(axis=1), 1e-300), 0.0, 1.0)
-    q = a + t[:, None] * e
-    d = np.hypot(*(q - point).T)
-    k = int(np.argmin(d))
-    return float(d[k]), q[k]
+def groove_nearest(gap: iso606.ToothGap, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Distance from sleeve centres (N, 2) lying between groove 0's centre line and the next
+    tooth's (polar angles 0 … π/z) to the exact outline, the nearest point, and whether a contact
+    there lies on the tip (the tip corner or the tip land).
+
+    Exact arcs, no polyline: the outline in that wedge is the seating arc's +y half, the flank and
+    the tip land up to the tooth's centre line; every other piece is a mirror image of one of
+    these across a bounding line of the wedge, so lies farther from a point inside it."""
+    j, c = gap.junction, gap.tip_corner
+    ha = gap.seating_angle_rad / 2.0
+    seat = _arc_nearest(points, gap.seating_centre, gap.seating_radius_mm, math.pi - ha, ha, j,
+                        gap.seating_centre + np.array([-gap.seating_radius_mm, 0.0]))
+    flank = _arc_nearest(points, gap.flank_centre, gap.flank_radius_mm, gap.flank_start_angle_rad,
+                         gap.flank_sweep_rad, j, c)
+    half = gap.half_pitch_angle_rad
+    tooth_centre = gap.tip_radius_mm * np.array([math.cos(half), math.sin(half)])
+    land = _arc_nearest(points, np.zeros(2), gap.tip_radius_mm, gap.tip_corner_angle_rad,
+                        gap.tip_land_half_angle_rad, c, tooth_centre)
+    dists = np.stack([seat[0], flank[0], land[0]])
+    piece = np.argmin(dists, axis=0)
+    rows = np.arange(len(points))
+    q = np.stack([seat[1], flank[1], land[1]])[piece, rows]
+    # On the tip when the centre lies past the flank's normal at the corner (the flank's nearest
+    # point is its end, the corner), whichever of flank and land is reported nearest: at the corner
+    # they differ only in the second order, below rounding, so their argmin does not decide.
+    on_tip = flank[2] & (piece != SEAT)
+    return dists[piece, rows], q, on_tip
 
 
-# Every this many vertices of the polyline, one is measured for the windowed search's upper bound.
-_WINDOW_PROBE_STRIDE = 16
-# The window's angle is widened by this factor over the bound (so what it excludes is strictly farther).
-_WINDOW_WIDEN = 1.0 + 1e-9
-
-
-class _Polyline:
-    """An open polyline whose vertices have strictly increasing polar angles (the groove's
-    outline, :func:`seat_polyline`), for :meth:`nearest` on an angular window of it.
-
-    Same figures as :func:`_nearest`, bit for bit: the per-segment arithmetic is the same (its
-    coordinate sums of two terms written out column by column, which is what the row sums
-    compute), and the window holds every segment at the nearest distance. u, the distance to the
-    nearest of every 16th vertex, bounds the nearest distance from above. A point at distance
-    ≤ u·(1 + 1e-9) from c lies within δ = asin(u·(1 + 1e-9)/|c|) of c's polar angle; a segment whose
-    two ends both lie beyond δ on one side lies wholly beyond it (polar angle is monotonic along a
-    segment that spans less than π), at distance ≥ |c|·sin δ > u from c. So the segments with an
-    end inside the window hold every nearest segment, and the first of them in polyline order is
-    the whole polyline's first. Where the bound does not apply (polar angles not strictly
-    increasing, u ≥ |c|) the whole polyline is searched."""
-
-    def __init__(self, poly: np.ndarray):
-        self.poly = poly
-        self.polar = np.arctan2(poly[:, 1], poly[:, 0])
-        self.windowed = bool(len(poly) > 2 and np.all(np.diff(self.polar) > 0.0)
-                             and np.ptp(self.polar) < math.pi / 2.0)
-        self.probes_x = np.ascontiguousarray(poly[::_WINDOW_PROBE_STRIDE, 0])
-        self.probes_y = np.ascontiguousarray(poly[::_WINDOW_PROBE_STRIDE, 1])
-        a, b = poly[:-1], poly[1:]
-        e = b - a
-        self.ax, self.ay = np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1])
-        self.ex, self.ey = np.ascontiguousarray(e[:, 0]), np.ascontiguousarray(e[:, 1])
-        self.ee = np.maximum(self.ex * self.ex + self.ey * self.ey, 1e-300)
-
-    def window(self, point: np.ndarray) -> slice:
-        """The segments (indices) that hold every segment nearest to ``point``."""
-        px, py = float(point[0]), float(point[1])
-        rho = math.hypot(px, py)
-        u = float(np.hypot(self.probes_x - px, self.probes_y - py).min()) * _WINDOW_WIDEN
-        if not self.windowed or not u < rho:
-            return slice(0, len(self.ax))
-        delta = math.asin(u / rho)
-        phi = math.atan2(py, px)
-        if not -math.pi < phi - delta < phi + delta < math.pi:  # the window would wrap round
-            return slice(0, len(self.ax))
-        lo = int(np.searchsorted(self.polar, phi - delta, "left"))
-        hi = int(np.searchsorted(self.polar, phi + delta, "right"))
-        # segment i joins vertices i and i + 1: those with an end in [lo, hi)
-        return slice(max(lo - 1, 0), min(hi, len(self.ax)))
-
-    def nearest(self, point: np.ndarray) -> tuple[float, np.ndarray]:
-        """:func:`_nearest` (point, whole polyline), on the window."""
-        w = self.window(point)
-        ax, ay, ex, ey = self.ax[w], self.ay[w], self.ex[w], self.ey[w]
-        px, py = point[0], point[1]
-        t = np.clip(((px - ax) * ex + (py - ay) * ey) / self.ee[w], 0.0, 1.0)
-        qx, qy = ax + t * ex, ay + t * ey
-        d = np.hypot(qx - px, qy - py)
-        k = int(np.argmin(d))
-        return float(d[k]), np.array([qx[k], qy[k]])
-
-
-def seat_check(gap: iso606.ToothGap, sleeve_radius_mm: float, elongation: float,
-               poly: np.ndarray | None = None) -> SeatResult:
-    """Checks 1 and 2 for one pin of a chain worn by ``elongation`` (fraction)."""
-    if poly is None:
-        poly = _outline_near_groove(gap, SEAT_OUTLINE_STEP_MM)
-    outline = _Polyline(poly)
+def seat_check(gap: iso606.ToothGap, sleeve_radius_mm: float, elongation: float) -> SeatResult:
+    """Checks 1 and 2 for one pin of a chain worn by ``elongation`` (fraction), on the exact arcs:
+    the sleeve centre, on R·(1 + e), is turned from the groove's centre line towards the next
+    tooth's until it first touches the outline (scan, then bisection of the angle); the link seats
+    if that contact lies on the seating arc or the flank, below the tip corner."""
     r_pin = gap.pitch_radius_mm * (1.0 + elongation)
     half = gap.half_pitch_angle_rad  # tooth centre at +π/z
 
-    def clearance(phi: float) -> tuple[float, np.ndarray]:
-        c = r_pin * np.array([math.cos(phi), math.sin(phi)])
-        dist, q = outline.nearest(c)
-        return dist - sleeve_radius_mm, q
+    def at(phis: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        centres = r_pin * np.column_stack([np.cos(phis), np.sin(phis)])
+        dist, q, tip = groove_nearest(gap, centres)
+        return dist - sleeve_radius_mm, q, tip
 
-    c0, _ = clearance(0.0)
-    if c0 < 0.0:  # cannot happen for e ≥ 0 (the groove widens outward); kept as a guard
+    phis = np.linspace(0.0, half, SEAT_SCAN_STEPS + 1)
+    clearance = at(phis)[0]
+    if clearance[0] < 0.0:  # cannot happen for e ≥ 0 (the groove widens outward); kept as a guard
         return SeatResult(False, "tip", math.nan, 0.0)
-    # scan to the first pose in contact, then bisect the shift
-    n = 400
-    phis = np.linspace(0.0, half, n + 1)
-    lo = 0.0
-    hi = None
-    for phi in phis[1:]:
-        if clearance(float(phi))[0] <= 0.0:
-            hi = float(phi)
-            break
-        lo = float(phi)
-    if hi is None:
+    touching = np.flatnonzero(clearance <= 0.0)
+    if not touching.size:
         return SeatResult(False, "jump", math.nan, math.degrees(half))
-    for _ in range(60):
+    lo, hi = float(phis[touching[0] - 1]), float(phis[touching[0]])
+    for _ in range(SEAT_BISECTIONS):
         mid = 0.5 * (lo + hi)
-        if clearance(mid)[0] > 0.0:
+        if at(np.array([mid]))[0][0] > 0.0:
             lo = mid
         else:
             hi = mid
-    _, q = clearance(hi)
-    rq = float(np.hypot(*q))
-    on_tip = rq >= gap.tip_radius_mm - TIP_CONTACT_TOL_MM
-    return SeatResult(not on_tip, "tip" if on_tip else "", rq, math.degrees(hi))
+    _, q, tip = at(np.array([hi]))
+    on_tip = bool(tip[0])
+    return SeatResult(not on_tip, "tip" if on_tip else "", float(np.hypot(*q[0])), math.degrees(hi))
 
 
 def tip_limit_closed_form(gap: iso606.ToothGap, sleeve_radius_mm: float) -> float:
     """Check 1's limit in closed form (fraction): the sleeve touches the flank exactly at the tip
     corner C, so its centre is C + r·n (n the flank's outward normal at C, from the flank centre
-    through C) and R·(1 + e) = |C + r·n|. What `gearcheck calc` shows; the check bisects the exact
-    model (all three modes)."""
+    through C) and R·(1 + e) = |C + r·n|. Exact: along the sleeve centres' path round the groove
+    (seating arc, flank, corner, tip land offset by r) the distance from the axis grows
+    monotonically, so the first contact passes from the flank to the corner at this radius."""
     c, f = gap.tip_corner, gap.flank_centre
     n = (c - f) / float(np.hypot(*(c - f)))
     return float(np.hypot(*(c + sleeve_radius_mm * n))) / gap.pitch_radius_mm - 1.0
@@ -272,40 +226,45 @@ def sweep_check(gap: iso606.ToothGap, link: tc.LinkGeometry, wrap: tc.ChainWrap,
 
 
 def sweep_clear(gap: iso606.ToothGap, link: tc.LinkGeometry, wrap: tc.ChainWrap, elongation: float,
-                exact: ExactSection | None = None, tables: Sequence[ExactTable] = ()) -> bool:
+                exact: ExactSection | None = None, tables: Sequence[ExactTable] = (),
+                margin_mm: float = 0.0) -> bool:
     """``sweep_check(...).ok`` (default steps and margin), measuring only what can decide it: a
-    sleeve or plate wholly outside the circle through the outline's farthest vertex is clear
-    without measuring (:meth:`ExactSection.clear_of_outline`), and the first pose that meets the
-    outline ends the search."""
+    sleeve or plate wholly outside the circle through the outline's farthest vertex (by more than
+    ``margin_mm``) is clear without measuring (:meth:`ExactSection.clear_of_outline`), and the
+    first pose that meets the outline ends the search. With ``margin_mm``: every distance
+    ≥ ``margin_mm`` (the polyline's sagitta: certainly clear on the exact arcs; minus it: not
+    certainly meeting them)."""
     w = worn_wrap(wrap.teeth, link.pitch_mm, elongation, wrap)
     before = int(math.ceil(WORN_SWEEP_MARGIN_FRACTION * WORN_SWEEP_STEPS_PER_CYCLE))
     angles = (np.arange(-before, WORN_SWEEP_STEPS_PER_CYCLE + before + 1) * w.cycle_rad
               / WORN_SWEEP_STEPS_PER_CYCLE)
     rows = _table_rows(tables, w, angles)
     if rows is not None:
-        return bool(rows[..., 0].min() >= 0.0 and rows[..., 1].min() >= 0.0)
+        return bool(rows[..., 0].min() >= margin_mm and rows[..., 1].min() >= margin_mm)
     exact = exact if exact is not None else ExactSection(gap, link)
     for a in angles:
         sp = tc.sprocket_matrix(float(a))
         for pose in w.link_matrices(float(a)):
-            sleeve_clear, plate_clear = exact.clear_of_outline(sp, pose)
+            sleeve_clear, plate_clear = exact.clear_of_outline(sp, pose, margin_mm)
             if sleeve_clear and plate_clear:
                 continue
             least = exact.sleeve_clearance(sp, pose) if plate_clear else min(exact.link_distances(sp, pose))
-            if least < 0.0:
+            if least < margin_mm:
                 return False
     return True
 
 
 @dataclass(frozen=True)
 class WearLimit:
-    limit: float  # largest elongation (fraction) at which every link seats (bracket's passing end)
-    fail_at: float  # bracket's failing end (limit + ≤ tolerance), nan if none failed
+    limit: float  # the elongation (fraction) at which a link first fails: see :func:`wear_limit`
+    fail_at: float  # the bracket's failing end: the true limit is ≤ this (nan if none failed)
     mode: str  # what fails first: one of MODES
     declared: float  # the template's declared elongation (fraction)
     declared_seat: SeatResult
     declared_sweep: SweepCheck
-    tolerance: float
+    tolerance: float  # the bisections' tolerance on e (fraction)
+    lo: float = 0.0  # the bracket's passing end: the true limit is ≥ this
+    tip_closed_form: float = 0.0  # the tip mode's limit in closed form (fraction), whatever decides
 
     @property
     def ok(self) -> bool:
@@ -315,40 +274,80 @@ class WearLimit:
     def mode_code(self) -> int:
         return MODES.index(self.mode)
 
+    @property
+    def closed_form(self) -> bool:
+        """Whether the limit is the tip mode's closed form (else the bracket's passing end)."""
+        return self.mode == "tip" and self.limit == self.tip_closed_form
+
+    def bracket_text(self) -> str:
+        """How the limit is known, in a few words (the verdict and the report say it)."""
+        if self.mode == "none":
+            return f"no failure up to {100 * self.lo:.4f} %"
+        span = f"{100 * self.lo:.6f}–{100 * self.fail_at:.6f} %"
+        if self.closed_form:
+            return f"closed form on the exact arcs, inside the bisection bracket {span}"
+        if self.mode == "sweep":
+            return (f"true limit within {span}: bisection ±{100 * self.tolerance:.4f} % on the worn-pitch sweep, "
+                    "widened by the outline's chord error")
+        return f"true limit within {span}: bisection on the exact arcs"
+
 
 def wear_limit(gap: iso606.ToothGap, link: tc.LinkGeometry, wrap: tc.ChainWrap, declared: float,
                tol: float = WEAR_BISECTION_TOL, bracket: float = WEAR_BRACKET_MAX,
                tables: Sequence[ExactTable] = ()) -> WearLimit:
-    """The elongation at which a link first fails to seat (bisection on e), and both checks at the
-    declared elongation (``tables``: see :func:`sweep_check`)."""
-    poly = _outline_near_groove(gap, SEAT_OUTLINE_STEP_MM)
+    """The elongation at which a link first fails to seat, with a bracket [lo, fail_at] the true
+    limit lies in, and both checks at the declared elongation (``tables``: see :func:`sweep_check`).
+
+    Seat modes (tip, jump) on the exact arcs (:func:`seat_check`): bisection on e to ``tol``; in
+    the tip mode the limit is its closed form (:func:`tip_limit_closed_form`), which the bracket
+    holds. Then the worn-pitch sweep, on the outline polyline of :class:`ExactSection`, whose
+    distances are within its chord sagitta s of the exact arcs' (the vertices lie on the arcs): a
+    sweep whose distances are all ≥ s is certainly clear, one with a distance < −s certainly meets
+    the sprocket. If the sweep is not certainly clear at the seat limit, two bisections find the
+    last certainly clear e (the limit, conservative) and the first certainly failing one (the
+    bracket's failing end; the seat limit's when the sweep is not certainly failing before it)."""
     section = ExactSection(gap, link)
+    r = link.sleeve_radius_mm
+    sag = section.sagitta_mm
 
-    def clear(e: float) -> bool:
-        return sweep_clear(gap, link, wrap, e, exact=section, tables=tables)
+    def clear(e: float, margin: float) -> bool:
+        return sweep_clear(gap, link, wrap, e, exact=section, tables=tables, margin_mm=margin)
 
-    declared_seat = seat_check(gap, link.sleeve_radius_mm, declared, poly)
+    declared_seat = seat_check(gap, r, declared)
     declared_sweep = sweep_check(gap, link, wrap, declared, exact=section, tables=tables)
+    closed = tip_limit_closed_form(gap, r)
 
-    # bisection on the seat check alone first (cheap), then the sweep inside that bracket
-    lo, hi, mode = 0.0, bracket, seat_check(gap, link.sleeve_radius_mm, bracket, poly).mode
-    if not mode:
-        hi, mode = math.nan, "none"
-    elif not seat_check(gap, link.sleeve_radius_mm, 0.0, poly).ok:
-        lo, hi, mode = 0.0, 0.0, seat_check(gap, link.sleeve_radius_mm, 0.0, poly).mode
+    # the seat check alone first (exact arcs, cheap), then the sweep up to its limit
+    seat0 = seat_check(gap, r, 0.0)
+    mode = seat_check(gap, r, bracket).mode
+    if not seat0.ok:
+        lo = hi = limit = 0.0
+        mode = seat0.mode
+    elif not mode:
+        lo, hi, limit, mode = bracket, math.nan, bracket, "none"
     else:
+        lo, hi = 0.0, bracket
         while hi - lo > tol:
             mid = 0.5 * (lo + hi)
-            m = seat_check(gap, link.sleeve_radius_mm, mid, poly).mode
+            m = seat_check(gap, r, mid).mode
             lo, hi, mode = (mid, hi, mode) if not m else (lo, mid, m)
+        limit = lo
+        if mode == "tip" and lo - tol <= closed <= hi + tol:
+            limit, lo, hi = closed, min(lo, closed), max(hi, closed)
     # does the worn-pitch sweep fail first?
-    if not clear(lo):
-        s_lo, s_hi = 0.0, lo
-        if not clear(0.0):
+    if not clear(limit, sag):
+        s_lo, s_hi = 0.0, limit
+        if not clear(0.0, sag):
             s_hi = 0.0
-        else:
-            while s_hi - s_lo > tol:
-                mid = 0.5 * (s_lo + s_hi)
-                s_lo, s_hi = (mid, s_hi) if clear(mid) else (s_lo, mid)
-        lo, hi, mode = s_lo, s_hi, "sweep"
-    return WearLimit(lo, hi, mode, declared, declared_seat, declared_sweep, tol)
+        while s_hi - s_lo > tol:
+            mid = 0.5 * (s_lo + s_hi)
+            s_lo, s_hi = (mid, s_hi) if clear(mid, sag) else (s_lo, mid)
+        if not clear(limit, -sag):  # certainly failing by the seat limit: where first?
+            f_lo, f_hi = s_lo, limit
+            while f_hi - f_lo > tol:
+                mid = 0.5 * (f_lo + f_hi)
+                f_lo, f_hi = (mid, f_hi) if clear(mid, -sag) else (f_lo, mid)
+            hi = f_hi if clear(s_lo, -sag) else s_lo
+        lo = limit = s_lo
+        mode = "sweep"
+    return WearLimit(limit, hi, mode, declared, declared_seat, declared_sweep, tol, lo, closed)
