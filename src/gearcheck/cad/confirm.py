@@ -66,17 +66,18 @@ DEPTH_SAMPLES = 15
 
 
 def _faces_near(shape, point: np.ndarray, radius: float):
-    """Compound of the faces whose bounding box comes within ``radius`` of ``point``."""
+    """Compound of the faces whose bounding box comes within ``radius`` of ``point`` (the whole
+    shape where none does)."""
+    faces = _faces_within(shape.wrapped, point, radius)
+    return _compound(faces) if faces else shape.wrapped
+
+
+def _compound(faces: list) -> TopoDS_Compound:
     builder, compound = BRep_Builder(), TopoDS_Compound()
     builder.MakeCompound(compound)
-    count = 0
-    for face in shape.Faces():
-        box = Bnd_Box()
-        BRepBndLib.Add_s(face.wrapped, box)
-        if box.Distance(Bnd_Box(gp_Pnt(*point), gp_Pnt(*point))) <= radius:
-            builder.Add(compound, face.wrapped)
-            count += 1
-    return compound if count else shape.wrapped
+    for face in faces:
+        builder.Add(compound, face)
+    return compound
 
 
 def _measure(a, b, label: str) -> BRepExtrema_DistShapeShape:
@@ -198,10 +199,7 @@ def penetration_depth(a, b, near: np.ndarray, radius: float = DEPTH_RADIUS_MM, s
     each point classified against ``b``, the distance to ``b``'s boundary of the deepest inside.
     0 where no sampled point is inside (touching, or an overlap thinner than the grid)."""
     classifier = BRepClass3d_SolidClassifier(b)
-    builder, boundary = BRep_Builder(), TopoDS_Compound()  # b's faces around the contact: depth is to them
-    builder.MakeCompound(boundary)
-    for face in _faces_within(b, near, 2.0 * radius + 1.0):
-        builder.Add(boundary, face)
+    boundary = _compound(_faces_within(b, near, 2.0 * radius + 1.0))  # depth is to b's faces around the contact
     deepest = 0.0
     for face in _faces_within(a, near, radius):
         surface = BRep_Tool.Surface_s(face)
