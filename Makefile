@@ -5,7 +5,7 @@ VENV   ?= .venv
 PY     := $(VENV)/bin/python
 STAMP  := $(VENV)/.gearcheck-installed
 
-.PHONY: install demo studies test browser lint bench fuzz clean
+.PHONY: install demo studies test browser lint bench fuzz docs clean
 
 install: $(STAMP)
 
@@ -29,6 +29,15 @@ browser:
 	@command -v chromium >/dev/null 2>&1 || { \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium; }
+
+# The API reference from the docstrings (offline, no network): out/api/index.html (tests/test_docs.py
+# builds the same list)
+API_MODULES := gearcheck gearcheck.design gearcheck.drafting gearcheck.mechanism gearcheck.results \
+	gearcheck.pipeline gearcheck.executor gearcheck.testing gearcheck.notebook gearcheck.figures gearcheck.params \
+	gearcheck.sweep gearcheck.geometry gearcheck.studies gearcheck.cad
+
+docs: $(STAMP)
+	$(VENV)/bin/pdoc --docformat restructuredtext -o out/api $(API_MODULES)
 
 lint: $(STAMP)
 	$(VENV)/bin/ruff check src bench

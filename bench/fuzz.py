@@ -91,7 +91,13 @@ def _lookup(body: dict, field: str):
 
 
 def check_rejection(body: dict, exc: ParamError, source: str = "fuzz") -> str | None:
-    """What is wrong with a rejection message, or None."""
+    """What is wrong with a rejection message, or None: one line per broken rule (several rules
+    named together carry ``errors``), each naming a field of the set and its allowed range."""
+    errors = getattr(exc, "errors", None)
+    if errors is not None:
+        lines_ok = str(exc).splitlines() == [str(e) for e in errors]
+        return next((p for e in errors if (p := check_rejection(body, e, source))), None) if lines_ok \
+            else "a line per broken rule expected"
     text = str(exc)
     if "\n" in text:
         return "message is more than one line"
@@ -162,7 +168,9 @@ class _Run:
 
     def validated(self, set_seed: int, data: dict):
         """The set's Params, or None (rejected: counted, its message checked)."""
-        body = {k: v for k, v in data.items() if k != "mechanism"}
+        from gearcheck.design import RUN_KEYS
+
+        body = {k: v for k, v in data.items() if k not in RUN_KEYS}  # mechanism, name, mesh_tol_mm: not Params
         self.stats["tried"] += 1
         t0 = time.perf_counter()
         try:

@@ -76,8 +76,16 @@ def _lookup(body: dict, path: list[str]):
 
 
 def check_rejection(mech: str, body: dict, exc: ParamError) -> None:
-    """One line: 'fuzz.toml: FIELD = VALUE: ... allowed ...', FIELD a path of the template whose
-    input value is VALUE."""
+    """One line per broken rule (independent rules are named together: ``exc.errors``), each
+    'fuzz.toml: FIELD = VALUE: ... allowed ...', FIELD a path of the template whose input value is
+    VALUE; ``exc`` itself carries the first one's."""
+    errors = getattr(exc, "errors", None)
+    if errors is not None:
+        assert str(exc).splitlines() == [str(e) for e in errors], str(exc)
+        assert (exc.field, exc.value) == (errors[0].field, errors[0].value), str(exc)
+        for e in errors:
+            check_rejection(mech, body, e)
+        return
     text = str(exc)
     assert "\n" not in text, text
     assert exc.field, text

@@ -28,7 +28,7 @@ from pydantic import Field
 
 from gearcheck.figures import Figure
 from gearcheck.geometry.bisect import bisect
-from gearcheck.geometry.involute import inv
+from gearcheck.geometry.spur import flank_sag_mm, rot_z, spur_outline
 from gearcheck.mechanism import Assembly, Mechanism, PartSpec, SweepPlan
 from gearcheck.params import Section
 from gearcheck.results import Clearance, Comparison, Plot, Report, Series, SweepOutcome, Verdict, WorstPose
@@ -66,40 +66,8 @@ class Params(Section):
 
 def outline(z: int, m: float, alpha: float, thinning: float) -> np.ndarray:
     """Counter-clockwise polygon of a spur gear (own frame, tooth 0 centred on +x)."""
-    r, rb = m * z / 2.0, m * z / 2.0 * math.cos(alpha)
-    ra, rf = r + m, r - (1.0 + ROOT_CLEARANCE) * m
-    psi = math.pi / (2 * z) - thinning / (2.0 * r)  # half tooth thickness at the pitch circle (angle)
-    start = max(rb, rf)
-    u = np.linspace(math.sqrt(max(start**2 / rb**2 - 1.0, 0.0)), math.sqrt(ra**2 / rb**2 - 1.0), FLANK_POINTS)
-    rho = rb * np.sqrt(1.0 + u**2)
-    theta = psi + float(inv(alpha)) - (np.tan(np.arccos(np.clip(rb / rho, -1, 1))) - np.arccos(np.clip(rb / rho, -1, 1)))
-    if theta[-1] <= 0.0:
-        raise ValueError("pointed teeth")
-    pts = []
-    for k in range(z):
-        c = 2 * math.pi * k / z
-        flank = [(rf, c - theta[0])] if rf < rb else []
-        flank += list(zip(rho, c - theta, strict=True))
-        tip = [(ra, a) for a in np.linspace(c - theta[-1], c + theta[-1], ARC_POINTS)[1:-1]]
-        back = [(p, 2 * c - a) for p, a in reversed(flank)]
-        nxt = c + 2 * math.pi / z
-        root = [(rf, a) for a in np.linspace(c + theta[0], nxt - theta[0], ARC_POINTS)[1:-1]]
-        pts += flank + tip + back + root
-    return np.array([[p * math.cos(a), p * math.sin(a)] for p, a in pts])
-
-
-def flank_sag_mm(z: int, m: float, alpha: float) -> float:
-    """Largest sag of the polygon's flank chords inside the involute: rb·u·du²/8 at the tip."""
-    rb, ra = m * z / 2.0 * math.cos(alpha), m * z / 2.0 + m
-    ua = math.sqrt(ra**2 / rb**2 - 1.0)
-    return rb * ua * (ua / (FLANK_POINTS - 1)) ** 2 / 8.0
-
-
-def rot_z(angle: float) -> np.ndarray:
-    m = np.eye(4)
-    c, s = math.cos(angle), math.sin(angle)
-    m[:2, :2] = [[c, -s], [s, c]]
-    return m
+    return spur_outline(z, m, alpha, thinning, flank_points=FLANK_POINTS, arc_points=ARC_POINTS,
+                        root_clearance=ROOT_CLEARANCE)
 
 
 # -- 3. Sweep task (module-level: runs in a worker with the scene built from the plan's meshes) --
@@ -184,7 +152,8 @@ class SpurPair(Mechanism):
                                  assembly.part("gear_2").motion.matrix(-phi * g.teeth_1 / g.teeth_2) @ base_2, reach))
                  for phi in angles]
         bound = bodies["gear_1"].error_bound_mm + bodies["gear_2"].error_bound_mm
-        sag = flank_sag_mm(g.teeth_1, g.module_mm, s["alpha"]) + flank_sag_mm(g.teeth_2, g.module_mm, s["alpha"])
+        sag = (flank_sag_mm(g.teeth_1, g.module_mm, s["alpha"], FLANK_POINTS)
+               + flank_sag_mm(g.teeth_2, g.module_mm, s["alpha"], FLANK_POINTS))
 
         def reduce(results: list) -> SweepOutcome:
             play = np.array([r["plus"] - r["minus"] for r in results])

@@ -1,4 +1,4 @@
-"""The Python API as the README documents it: the README's example block runs as written (in a
+"""The Python API as docs/python.md documents it: its example block runs as written (in a
 scratch folder holding the templates), then its results are checked against the CLI's."""
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ pytestmark = pytest.mark.cad
 
 
 def readme_example() -> str:
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "python.md").read_text(encoding="utf-8")
     match = re.search(r"<!-- api-example -->\s*```python\n(.*?)```", text, re.S)
-    assert match, "README has no api-example block"
+    assert match, "docs/python.md has no api-example block"
     return match.group(1)
 
 
@@ -33,7 +33,7 @@ def ran(tmp_path_factory):
     os.chdir(work)
     try:
         namespace: dict = {}
-        exec(compile(readme_example(), "README.md", "exec"), namespace)
+        exec(compile(readme_example(), "docs/python.md", "exec"), namespace)
     finally:
         os.chdir(cwd)
     return work, namespace

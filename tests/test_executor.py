@@ -363,3 +363,45 @@ def test_a_script_read_from_stdin_is_one_line_naming_the_cause(tmp_path):
                          cwd=tmp_path)
     assert out.returncode == 0, out.stderr
     assert "cannot start from a script that is not a file (<stdin>" in out.stdout and "jobs=1" in out.stdout
+
+
+def test_a_mechanism_defined_in_a_session_fails_before_the_build_with_the_cure(tmp_path):
+    """Before: a mechanism defined in a notebook (here ``python -c``) checked with the default jobs
+    never returned: the workers died with ``Can't get attribute 'measure_play' on <module
+    '__main__'>`` and the pool waited (killed by a timeout after 150 s). Now one line names what the
+    workers cannot load and the cure, before anything is built; and the worker-side check names it
+    too when only a task's data lives in ``__main__``."""
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    spur = Path(__file__).with_name("spur_pair.py")
+    script = (f"exec(open({str(spur)!r}).read())\n"
+              "import gearcheck\nfrom gearcheck import mechanism\nfrom gearcheck.executor import WorkerError\n"
+              "mechanism.register(SpurPair)\n"
+              "try:\n"
+              f"    gearcheck.load(TEMPLATE).check(out={str(tmp_path / 'run')!r}, jobs=2)\n"
+              "except WorkerError as exc:\n"
+              "    print(exc)\n")
+    started = time.monotonic()
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, cwd=tmp_path)
+    assert time.monotonic() - started < 10
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == ("worker processes cannot load __main__.SpurPair: it is defined in this session (a "
+                                  "notebook, python -c or an interactive shell), which they cannot import; define the "
+                                  "mechanism in an importable module, or run with jobs=1")
+    assert not (tmp_path / "run").exists()
+
+
+def test_names_in_main_are_found_in_a_tasks_pickle(monkeypatch):
+    import sys
+
+    from gearcheck.executor import _names_main
+
+    namespace: dict = {"__name__": "__main__"}
+    exec("class Local:\n    pass\n", namespace)  # noqa: S102 - a class no module holds
+    local = namespace["Local"]
+    monkeypatch.setattr(sys.modules["__main__"], "Local", local, raising=False)
+    assert _names_main((1, local())) == "Local"
+    assert _names_main((1, [2.0], {"a": "__main__"})) is None

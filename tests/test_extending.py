@@ -71,3 +71,49 @@ def test_one_worker_gives_the_same_files(checked, tmp_path):
     again = design.check(out=tmp_path, jobs=1)
     for name in ("summary.json", "sweep.csv"):
         assert (tmp_path / name).read_bytes() == (run.folder / name).read_bytes(), name
+
+
+class _BadClearance(SpurPair):
+    name = section = "spur_bad_clearance"
+
+    def smallest_clearance(self, params):
+        from gearcheck.results import Clearance
+
+        return Clearance(0.0, "no clearance at all")
+
+
+class _BadAnalyse(SpurPair):
+    name = section = "spur_bad_analyse"
+
+    def analyse(self, params):
+        raise RuntimeError("boom\nsecond line")
+
+
+@pytest.mark.parametrize("cls, command, line", [
+    (_BadClearance, "check", "the spur_bad_clearance mechanism's smallest_clearance hook failed: ValueError: returned "
+                             "Clearance(0.0 mm): a clearance to resolve must be > 0 mm"),
+    (_BadAnalyse, "calc", "the spur_bad_analyse mechanism's analyse hook failed: RuntimeError: boom second line"),
+])
+def test_a_plugins_error_is_exit_3_naming_the_mechanism_and_the_hook(tmp_path, capsys, caplog, cls, command, line):
+    """Before: a plugin's exception (a Clearance(0.0)) ended as a traceback with exit 1, the code of
+    a failed verdict, so CI read it as a failed design. Now: exit 3, one line naming the mechanism
+    and the hook, the traceback under -v."""
+    import tomli_w
+
+    from gearcheck.cli import main
+
+    impl = registry.register(cls)
+    try:
+        path = tmp_path / "t.toml"
+        path.write_text(tomli_w.dumps({**TEMPLATE, "mechanism": cls.name}))
+        args = [command, str(path)] + (["--out", str(tmp_path / "run"), "--jobs", "1"] if command == "check" else [])
+        assert main(args) == 3
+        err = [e for e in capsys.readouterr().err.strip().splitlines() if not e.startswith("building ")]
+        assert len(err) == 1 and err[0].startswith(f"gearcheck: error: {line}"), err
+        assert err[0].endswith("(run with -v for the traceback)")
+        with caplog.at_level("INFO", logger="gearcheck"):  # -v: the traceback goes to the log (stderr)
+            assert main(["-v", *args]) == 3
+        assert any(r.exc_info and isinstance(r.exc_info[1], registry.HookError) for r in caplog.records)
+        assert not (tmp_path / "run").exists()
+    finally:
+        registry.unregister(cls.name)

@@ -10,7 +10,9 @@ check run:
   point lies on its own solid, and exact_distance is unchanged;
 * the GLB re-read by trimesh: one node per part named after it at its pose, the right triangle
   count and material colour on each, copies sharing one mesh; the worst poses as further scenes
-  with their closest points; the file is deterministic and glTF-valid in its framing.
+  with their closest points; the file is deterministic and glTF-valid in its framing;
+* glTF's units and axes: the scene trimesh reads is in metres with Y up, its bounds the assembly's
+  millimetre Z-up bounds scaled by 0.001 and turned (x, y, z) → (x, z, −y).
 """
 
 from __future__ import annotations
@@ -214,9 +216,10 @@ def test_glb_reads_back_with_named_coloured_nodes(runs, name):
     names = {p.name for p in scene.parts}
     assert names <= set(loaded.graph.nodes_geometry)
     geometry_of = {}
+    to_gltf = np.array([[1e-3, 0, 0, 0], [0, 0, 1e-3, 0], [0, -1e-3, 0, 0], [0, 0, 0, 1]], float)
     for part in scene.parts:
         transform, key = loaded.graph[part.name]
-        assert np.allclose(transform, part.pose, atol=1e-6), part.name
+        assert np.allclose(transform, to_gltf @ part.pose, atol=1e-9), part.name
         mesh = loaded.geometry[key]
         assert len(mesh.faces) == part.triangles, part.name
         assert np.allclose(np.asarray(mesh.vertices), np.asarray(part.vertices), atol=1e-5)
@@ -227,14 +230,23 @@ def test_glb_reads_back_with_named_coloured_nodes(runs, name):
         geometry_of[part.name] = key
     assert len(set(geometry_of.values())) == len({id(p.vertices) for p in scene.parts}), "copies must share a mesh"
 
+    # metres, Y up: the bounds trimesh reads are the assembly's (mm, Z up) scaled and turned
+    world = np.concatenate(list(scene.world_vertices().values()))
+    lo, hi = world.min(axis=0), world.max(axis=0)
+    expected = np.array([[lo[0], lo[2], -hi[1]], [hi[0], hi[2], -lo[1]]]) * 1e-3
+    assert np.allclose(loaded.bounds, expected, atol=1e-7), (loaded.bounds, expected)
     tree = glb_json(data)
-    assert tree["asset"]["extras"]["units"] == "mm"
+    assert tree["asset"]["extras"]["units"].startswith("m, Y up")
+    assert tree["scenes"][0]["nodes"] == [tree["nodes"].index(next(n for n in tree["nodes"]
+                                                                    if n["name"] == f"{scene.name}_m_yup"))]
     assert [s["name"] for s in tree["scenes"]] == [scene.name] + [f"worst_{i + 1}" for i in range(len(scene.worst))]
     for view, entry in zip(scene.worst, tree["scenes"][1:], strict=True):
         assert entry["extras"]["distance_mm"] == pytest.approx(view.distance_mm, abs=1e-12)
         assert np.allclose(entry["extras"]["point_a"], view.point_a)
         assert np.allclose(entry["extras"]["point_b"], view.point_b)
-        nodes = {tree["nodes"][i]["name"]: tree["nodes"][i] for i in entry["nodes"]}
+        (root,) = entry["nodes"]
+        assert tree["nodes"][root]["name"] == entry["name"] + "_m_yup"
+        nodes = {tree["nodes"][i]["name"]: tree["nodes"][i] for i in tree["nodes"][root]["children"]}
         prefix = entry["name"] + "/"
         assert {prefix + n for n in names} <= set(nodes)
         for part, pose in view.poses.items():

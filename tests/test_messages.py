@@ -102,7 +102,7 @@ def test_unknown_key_in_a_list_of_tables_names_the_allowed_keys(tmp_path, templa
 def test_a_key_where_none_is_allowed():
     from pydantic import ValidationError
 
-    from gearcheck.params.common import Section, _first_error
+    from gearcheck.params.common import Section, _errors
 
     class Empty(Section):
         pass
@@ -112,7 +112,7 @@ def test_a_key_where_none_is_allowed():
 
     with pytest.raises(ValidationError) as info:
         Model.model_validate({"empty": {"x": 1}})
-    exc = _first_error(Model, info.value, {})
+    exc = _errors(Model, info.value, {})
     assert str(exc) == "empty.x = 1: unknown key (no keys are allowed here)"
 
 

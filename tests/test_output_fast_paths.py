@@ -91,7 +91,7 @@ def test_stls_of_a_build_watertight_as_the_row_sort(build_bodies):
 def test_mesh_pairs_answer_as_the_sweep_tools(template_check):
     """One scene per pair at the worst poses: the same overlap and nearest points as building
     the scene for each question."""
-    from gearcheck.pipeline import _MeshPairs
+    from gearcheck.confirmation import _MeshPairs
     from gearcheck.sweep.tools import mesh_nearest_midpoint, meshes_overlap
 
     run = template_check("eod_track_drive")

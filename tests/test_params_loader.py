@@ -15,6 +15,7 @@ TEMPLATE_FILES = {
     "differential": "zhurong_differential.toml",
     "track": "eod_track_drive.toml",
     "steering": "nose_wheel_steering.toml",
+    "roller_chain": "roller_chain_12B_z21.toml",
 }
 
 

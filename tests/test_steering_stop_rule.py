@@ -329,6 +329,47 @@ def test_below_equal_travel_the_rack_stands_where_S1_passes_S2():
     assert s6.overlap_mm == pytest.approx(0.136, abs=1e-3) and s6.overlap_swing == "forward"
 
 
+def test_the_stand_at_RS1_83_3_by_hand():
+    """The stand that decides RS1 83.3 / hS6 26.2, from the template's inputs with a pocket calculator's
+    formulas: a pinion tip corner at radius R and polar angle γ = (j + ½)τ + φ + β(R) (β the involute
+    half angle) pushing a straight rack flank puts the rack at L = x − k·p + w(y), w(y) = p/4 − (y − h)·tan α
+    the half width at height y (h the rolling line). When G1's corner S1 (R = RS1) reaches S2's height
+    the rack is at 105.482 mm and G2's corner S3 (R = Ra) would hold it only at 105.07: 0.40 mm short, so
+    nothing carries the rack while G1's tip land passes over the S2–S6 top, and the top must clear the
+    RS1 circle there. That circle's tangent at S2 rises 0.187 mm per mm; the top to hS6 = 26.2 rises
+    0.28 mm per mm, so S1 meets it at once."""
+    m, z, alpha, H, rs1, ra, hs2, hs6 = 4.0, 42, math.radians(25.0), 107.0, 83.3, 88.0, 25.13, 26.2
+    r, p, tau = m * z / 2.0, math.pi * m, 2.0 * math.pi / z
+    h = H - r
+    rb = r * math.cos(alpha)
+
+    def inv(a: float) -> float:
+        return math.tan(a) - a
+
+    def corner(j: int, radius: float, phi: float) -> tuple[float, float]:
+        beta = math.pi / (2 * z) + inv(alpha) - inv(math.acos(rb / radius))
+        gamma = (j + 0.5) * tau + phi + beta
+        return radius * math.sin(gamma), H - radius * math.cos(gamma)
+
+    def travel(k: int, x: float, y: float) -> float:
+        return x - k * p + p / 4.0 - (y - h) * math.tan(alpha)
+
+    from scipy.optimize import brentq
+
+    phi = brentq(lambda a: corner(-8, rs1, a)[1] - hs2, math.radians(70.0), math.radians(75.0))
+    at_s2 = travel(-7, *corner(-8, rs1, phi))
+    by_s3 = travel(-6, *corner(-7, ra, phi))
+    assert math.degrees(phi) == pytest.approx(72.556, abs=1e-3) and at_s2 == pytest.approx(105.482, abs=1e-3)
+    assert at_s2 - by_s3 == pytest.approx(0.404, abs=2e-3)
+    x_s2 = corner(-8, rs1, phi)[0]
+    tangent_slope = x_s2 / (H - hs2)  # the RS1 circle's slope at S2 (its radius there is perpendicular)
+    half = (p / 4.0 - (hs2 - h) * math.tan(alpha), p / 4.0 - (hs6 - h) * math.tan(alpha))
+    top_slope = (hs6 - hs2) / (half[0] + half[1])
+    assert tangent_slope == pytest.approx(0.187, abs=1e-3) and top_slope == pytest.approx(0.282, abs=1e-3)
+    g, tow, (s6, _) = _gearcheck(["pinion.topped_radius_mm=83.3", "trim.hS6_mm=26.2"])
+    assert ends.stands(g, tow)[0].travel_mm == pytest.approx(at_s2, abs=1e-4)
+
+
 # ----------------------------------------------------------------------------- the check
 
 @pytest.mark.cad
@@ -352,6 +393,17 @@ def test_a_top_the_tip_land_catches_fails_the_check_not_the_input(tmp_path, caps
     failed = {name for name, ok in s["verdicts"].items() if not ok}
     assert failed == {"no_interference_past_disengage", "no_interference_anywhere"}
     assert all(s["verdict_evidence"][name].startswith("exact model") for name in failed)
-    out = " ".join(capsys.readouterr().out.split())
+    # where the mesh sweep found the pinion in the rack deeper than the contact tolerance, that pose is
+    # confirmed on the exact solids: they overlap there, by a volume (RS1 83.3: the rack stands at
+    # 105.482 mm while G1's tip land comes over the top; hS6 26.15: the meshed top drags the rack on)
+    if s["min_signed_clearance_mm"] < -s["contact_tolerance_mm"]:
+        deepest = s["exact_confirmation"]["deepest_overlap_of_the_sweep"]
+        assert deepest["contact"] == "overlapping" and deepest["overlap_mm3"] > 1e-3 and deepest["agrees"] == 1.0
+    else:
+        assert "deepest_overlap_of_the_sweep" not in s["exact_confirmation"]
+    assert (s["min_signed_clearance_mm"] < -s["contact_tolerance_mm"]) == ("83.3" in " ".join(overrides))
+    out = " ".join(" ".join(s["verdict_measured"][name] for name in failed).split())  # the whole sentences
     for w in words:
         assert w in out, w
+    shown = capsys.readouterr().out  # the terminal: one line each, the shortfall
+    assert "FAIL  towing: no interference past the disengage" in shown and "hS6 = 26." in shown

@@ -120,6 +120,10 @@ def test_cli_writes_one_transaction_and_bad_input_is_one_line(tmp_path, capsys):
     path = write(tmp_path, samples=32)
     out = tmp_path / "out"
     assert main(["study", str(path), "--out", str(out), "--jobs", "1"]) == 0
+    # piped (stderr not a terminal): a line per stage and per tenth of its work, not minutes of silence
+    err = capsys.readouterr().err
+    assert "study: analytical model …" in err and "analytical model: 32/32 variant (100 %)" in err
+    assert "done in" in err
     names = sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
     assert names == ["manifest.json", "report.html", "results.parquet", "summary.json"]
     manifest = json.loads((out / "manifest.json").read_text())
@@ -228,3 +232,29 @@ def test_templates_lists_the_shipped_studies_and_study_runs_one_by_name(capsys, 
     assert main(["study", "no_such_study", "--out", str(tmp_path / "x")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "no_such_study" in err[0] and "track_wear" in err[0]
+
+
+def test_study_report_reads_like_the_check_report(tmp_path):
+    """Before: raw keys as axis labels, offset notation ("+1.656"), legends inside the axes, a
+    paper-vs-exact identity plot with nothing to see, P(fail) curves of noise at 64 variants, and a
+    red "1 of 3 failure modes seen" headline for a study that draws wear past the limit on purpose.
+    Now: labels in words with their unit and level, no offsets, the headline sets each failure's
+    count against the distributions drawn (neutral, not a verdict), curves only from 200 variants,
+    and the two models' difference (or one line where they agree everywhere)."""
+    import re
+
+    from gearcheck.studies.report import CURVE_MIN_VARIANTS, label_of
+
+    assert label_of("exact.wear_margin_pct") == "wear margin (%), exact model"
+    assert label_of("analytical.seating_radius_mm", {"seating_radius_mm": "seating radius ri"}) == \
+        "seating radius ri (mm), paper's model"
+    res = gearcheck.study(write(tmp_path, samples=64), jobs=1, out=tmp_path / "out")
+    page = (tmp_path / "out" / "report.html").read_text()
+    banner = re.search(r"<div class='banner (\w+)'>(.*?)</div>", page, re.S)
+    assert banner.group(1) == "info" and "drawn from: chain.wear_elongation_pct uniform 0 to 3 %" in banner.group(2)
+    assert "seat_large</code> (seating radius above mean + 1 sd): " in banner.group(2)
+    assert res.summary["failures"]["seat_large"]["variants"] < CURVE_MIN_VARIANTS
+    assert "fewer than the 200 a curve needs" in page
+    svg_text = " ".join(re.findall(r"<text[^>]*>([^<]*)</text>", page))
+    assert "analytical.seating_radius_mm" not in svg_text and "paper&#x27;s model" in page or "paper's model" in page
+    assert not re.search(r"[+−-]\d\.\d+e?[+−-]?\d*\s*$", svg_text)  # no offset text on an axis

@@ -24,12 +24,13 @@ __version__ = "0.1.0"
 
 __all__ = [
     "CheckResult", "Comparison", "Design", "Mechanism", "ParamError", "Plot", "StudyResult", "Verdict", "WorstPose",
-    "__version__", "load", "mechanism_names", "study",
+    "__version__", "load", "mechanism_names", "new", "study",
 ]
 
 # name → (module, attribute); resolved lazily by __getattr__
 _LAZY = {
     "load": ("gearcheck.design", "load"),
+    "new": ("gearcheck.drafting", "new"),
     "study": ("gearcheck.studies.core", "study"),
     "StudyResult": ("gearcheck.studies.core", "StudyResult"),
     "Design": ("gearcheck.design", "Design"),
@@ -47,6 +48,7 @@ if TYPE_CHECKING:
 
     from gearcheck.design import Design, load
     from gearcheck.mechanism import Mechanism
+    from gearcheck.drafting import new
     from gearcheck.params.common import ParamError
     from gearcheck.results import CheckResult, Comparison, Plot, Verdict, WorstPose
     from gearcheck.studies.core import StudyResult, study

@@ -130,6 +130,35 @@ def build_parser() -> argparse.ArgumentParser:
     _add_jobs_arg(demo, "the sweeps")
     _add_open_arg(demo, "each report (the output folder with --no-cad)")
 
+    new = sub.add_parser(
+        "new", formatter_class=_Formatter,
+        help="write a complete template for your design from the few numbers that define it",
+        description="Write a complete template for a design of your own from the numbers that define it: "
+        "every dependent dimension derived by the paper's own design method or the standard (the "
+        "differential's cone distances and shaft lengths, the steering's trim heights and topped radius, "
+        "a roller-chain sprocket's ISO 606 tooth form), each value with a comment saying how it was found. "
+        "`gearcheck check FILE` then gives its verdict with no edits. Any other value: --set (an input to "
+        "the derivation where it is one). The numbers each mechanism takes:\n"
+        "  differential  --module M --teeth SMALL/BIG   (side gear / planet bevel gears)\n"
+        "  steering      --module M --teeth Z           (pinion teeth)\n"
+        "  roller_chain  --chain 12B --teeth Z [--strands 1-3]   (ISO 606 A or B series)",
+        epilog="Examples:\n  gearcheck new differential --module 3 --teeth 14/30 --out my_diff.toml\n"
+               "  gearcheck new steering --module 5 --teeth 34 --out my_steering.toml\n"
+               "  gearcheck new roller_chain --chain 16A --teeth 25 --strands 2 --out my_sprocket.toml\n"
+               "  gearcheck new differential --module 2 --teeth 16/40 --set operating.cold_C=-120 --out d.toml\n"
+               "  gearcheck check my_diff.toml",
+    )
+    new.add_argument("mechanism", metavar="MECHANISM", help="differential, steering or roller_chain")
+    new.add_argument("--module", default=None, metavar="M", help="gear module, mm")
+    new.add_argument("--teeth", default=None, metavar="Z", help="tooth count(s): Z, or SMALL/BIG for a pair")
+    new.add_argument("--chain", default=None, metavar="DESIGNATION", help="ISO 606 chain, e.g. 08B, 12B, 16A")
+    new.add_argument("--strands", default=None, metavar="N", help="chain strands, 1 to 3 (default 1)")
+    new.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
+                     help="set any other template value (repeatable); an input of the derivation where it is one")
+    new.add_argument("--out", type=Path, default=None, metavar="FILE.toml",
+                     help="template to write (default: MECHANISM_NUMBERS.toml here; - prints it)")
+    new.add_argument("--force", action="store_true", help="replace --out if it exists")
+
     study = sub.add_parser(
         "study", formatter_class=_Formatter,
         help="Monte Carlo over tolerances, temperature and wear: probabilities of failure, sensitivities",

@@ -66,7 +66,11 @@ if TYPE_CHECKING:
 
 
 class _Plain:
-    """Progress where stderr is not a terminal: no bars, one line when a template starts."""
+    """Progress where stderr is not a terminal: no bars, one line when a template starts; with
+    ``tenths`` (a study, minutes long), a line per stage and per tenth of its work too."""
+
+    def __init__(self, tenths: bool = False) -> None:
+        self.tenths = tenths
 
     def __enter__(self) -> _Plain:
         return self
@@ -78,16 +82,18 @@ class _Plain:
         print(f"{desc} ...", file=sys.stderr)
 
     def __call__(self, desc: str, total: int | None = None, unit: str = "") -> contextlib.AbstractContextManager[Bar]:
+        from gearcheck.notebook import line_progress
         from gearcheck.pipeline import no_progress
 
-        return no_progress(desc, total, unit)
+        return line_progress(desc, total, unit, sys.stderr) if self.tenths else no_progress(desc, total, unit)
 
 
-def _display() -> Any:
-    """Progress bars on stderr when it is a terminal, else nothing but a line per template."""
+def _display(tenths: bool = False) -> Any:
+    """Progress bars on stderr when it is a terminal, else a line per template (``tenths``: and a
+    line per stage and per tenth of its work)."""
     from gearcheck.terminal import Bars
 
-    return Bars() if sys.stderr.isatty() else _Plain()
+    return Bars() if sys.stderr.isatty() else _Plain(tenths)
 
 
 class _StderrHandler(logging.StreamHandler):
@@ -136,7 +142,14 @@ def cmd_calc(args) -> int:
     if args.json:
         print(json.dumps(calc.to_dict(), indent=2, allow_nan=False))
     else:
-        _show(*calc_view(f"{design.name} ({design.mechanism}) — analytical model", calc.figures, _screen()))
+        import dataclasses
+
+        from gearcheck.terminal import CALC_WIDTH
+
+        screen = _screen()
+        if screen.width is None:  # piped: the table fits CALC_WIDTH columns (notes wrap or go under)
+            screen = dataclasses.replace(screen, width=CALC_WIDTH)
+        _show(*calc_view(f"{design.name} ({design.mechanism}) — analytical model", calc.figures, screen))
     return 0
 
 
@@ -367,6 +380,25 @@ def cmd_schema(args) -> int:
     return 0
 
 
+def cmd_new(args) -> int:
+    """Write a complete template from the numbers that define a design (gearcheck.new)."""
+    from gearcheck.drafting import default_name, draft, new
+
+    inputs = {"module": args.module, "teeth": args.teeth, "chain": args.chain, "strands": args.strands}
+    if args.out is not None and str(args.out) == "-":
+        from gearcheck.design import from_data
+
+        result = draft(args.mechanism, args.overrides, **inputs)
+        from_data(result.data())
+        sys.stdout.write(result.toml())
+        return 0
+    out = args.out if args.out is not None else Path(default_name(args.mechanism, inputs))
+    design = new(args.mechanism, out=out, overrides=args.overrides, force=args.force, **inputs)
+    print(f"wrote {out}: {design.impl.title}")
+    print(f"  every derived value is commented with how it was found; check it: gearcheck check {out}")
+    return 0
+
+
 def cmd_study(args) -> int:
     """A study: headline figures on stdout, the files in --out."""
     from gearcheck.studies.core import study
@@ -376,7 +408,7 @@ def cmd_study(args) -> int:
     check_scheduler(args.scheduler)
     path = find_study(args.study)
     out = args.out if args.out is not None else Path("out") / f"study_{path.stem}"
-    with _display() as bars:
+    with _display(tenths=True) as bars:
         result = study(path, samples=given["samples"], seed=given["seed"], jobs=args.jobs, scheduler=args.scheduler,
                        out=out, exact=given["exact"], check_worst=given["check_worst"], progress=bars)
     s = result.summary
@@ -404,7 +436,7 @@ def cmd_study(args) -> int:
 
 
 COMMANDS = {"calc": cmd_calc, "study": cmd_study, "build": cmd_build, "check": cmd_check, "demo": cmd_demo,
-            "templates": cmd_templates, "schema": cmd_schema}
+            "templates": cmd_templates, "schema": cmd_schema, "new": cmd_new}
 
 
 def _one_line(exc: BaseException, limit: int = 300) -> str:
@@ -413,7 +445,8 @@ def _one_line(exc: BaseException, limit: int = 300) -> str:
 
 
 def _error(text: str, code: int = 2) -> int:
-    print(f"gearcheck: error: {text}", file=sys.stderr)
+    for line in text.splitlines() or [""]:  # several broken rules: one line each
+        print(f"gearcheck: error: {line}", file=sys.stderr)
     return code
 
 
@@ -504,9 +537,13 @@ def _failed(exc: Exception, verbose: bool) -> int:
             _quiet_stdout()
             return _error(str(output_error(exc, "<stdout>")))
         return _error(str(output_error(exc, verb="access")))
+    from gearcheck.mechanism import HookError
+
     logging.getLogger("gearcheck").info("internal error", exc_info=exc)
     where = "" if verbose else " (run with -v for the traceback)"
-    return _error(f"internal error: {type(exc).__name__}: {_one_line(exc)}{where}", 3)
+    # a mechanism's hook (a plugin's, or gearcheck's own) names itself; anything else is gearcheck's
+    text = _one_line(exc) if isinstance(exc, HookError) else f"internal error: {type(exc).__name__}: {_one_line(exc)}"
+    return _error(text + where, 3)
 
 if __name__ == "__main__":
     raise SystemExit(main())

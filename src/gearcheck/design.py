@@ -53,7 +53,35 @@ class Calc:
         for f in self.figures:
             if f.key == key:
                 return f.value
-        raise KeyError(key)
+        from gearcheck.notebook import missing_key
+
+        raise missing_key(key, self.keys())
+
+    def keys(self) -> list[str]:
+        """Every figure's key, in the table's order (``calc[key]`` reads one)."""
+        return [f.key for f in self.figures]
+
+    def __contains__(self, key: object) -> bool:
+        return any(f.key == key for f in self.figures)
+
+    def figure(self, key: str) -> Figure:
+        """The figure itself: label, value, unit, the paper's value where it has one, note."""
+        for f in self.figures:
+            if f.key == key:
+                return f
+        from gearcheck.notebook import missing_key
+
+        raise missing_key(key, self.keys())
+
+    def __repr__(self) -> str:
+        from gearcheck.notebook import calc_repr
+
+        return calc_repr(self.section, self.figures)
+
+    def _repr_html_(self) -> str:
+        from gearcheck.notebook import calc_html
+
+        return calc_html(self.section, self.figures)
 
 
 @dataclass(frozen=True)
@@ -64,6 +92,9 @@ class Design:
     mechanism: str
     params: BaseModel
     data: dict
+
+    def __repr__(self) -> str:
+        return f"<Design {self.name} ({self.mechanism}) from {self.source}>"
 
     @property
     def impl(self) -> registry.Mechanism:
@@ -94,7 +125,8 @@ class Design:
     # -- what a user does with a design --------------------------------------------------------
     def calc(self) -> Calc:
         """The analytical model (numpy only)."""
-        return Calc(self.impl.section, self.impl.analyse(self.params))
+        with registry.calling(self.impl, "analyse"):
+            return Calc(self.impl.section, self.impl.analyse(self.params))
 
     def build(self, out: str | Path | None = None, *, tol: float | None = None) -> BuildRun:
         """Build the CAD and write what ``gearcheck build`` writes into ``out`` (default out/NAME)."""
@@ -103,13 +135,18 @@ class Design:
         return pipeline.build(self, Path(out) if out is not None else Path("out") / self.name, tol_mm=tol)
 
     def check(self, out: str | Path | None = None, *, tol: float | None = None, jobs: int | None = None,
-              executor: Executor | None = None, options: Mapping[str, Any] | None = None) -> CheckRun:
+              executor: Executor | None = None, options: Mapping[str, Any] | None = None,
+              progress: bool | None = None) -> CheckRun:
         """Build, sweep and report as ``gearcheck check`` does, into ``out`` (default out/NAME).
-        ``jobs``: worker processes (default every core; 1 runs in this process)."""
+        ``jobs``: worker processes (default every core; 1 runs in this process). ``progress``: print
+        a line per stage and per tenth of its work (default: in a Jupyter notebook only)."""
         from gearcheck import pipeline
+        from gearcheck.notebook import in_notebook, line_progress
 
+        show = in_notebook() if progress is None else progress
         return pipeline.check(self, Path(out) if out is not None else Path("out") / self.name, tol_mm=tol,
-                              jobs=jobs, executor=executor, options=options)
+                              jobs=jobs, executor=executor, options=options,
+                              progress=line_progress if show else pipeline.no_progress)
 
     def assembly_cad(self):
         """A named, coloured ``cadquery.Assembly`` of the parts as built (shows in ocp_vscode)."""

@@ -131,14 +131,51 @@ def _resolve(ref: tuple[str, str]) -> Callable[..., Any]:
     return found
 
 
-def _check_main_importable() -> None:
+def _names_main(*objects: Any) -> str | None:
+    """The first name the pickles of ``objects`` look up in ``__main__`` (a function or class
+    defined in a notebook, ``python -c`` or a script), None when they look up none."""
+    import pickletools
+
+    for obj in objects:
+        if obj is None:
+            continue
+        try:
+            data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception:  # noqa: BLE001 - what cannot pickle fails where the map sends it, with its own message
+            return None
+        if b"__main__" not in data:
+            continue
+        strings: list[str] = []
+        for op, arg, _ in pickletools.genops(data):
+            if isinstance(arg, str):
+                if op.name in ("GLOBAL", "INST") and arg.startswith("__main__ "):
+                    return arg.split(" ", 1)[1]
+                strings.append(arg)
+            elif op.name == "STACK_GLOBAL" and len(strings) >= 2 and strings[-2] == "__main__":
+                return strings[-1]
+    return None
+
+
+def check_main_importable(fn: Any = None, setup: Any = None, task: Any = None) -> None:
     """A spawned worker first runs the script its parent was started from (as ``__mp_main__``);
     a script read from standard input (``python - < script.py``) or any other file that is not
-    there has nothing to run, and every worker would die starting. Said in one line instead."""
+    there has nothing to run, and every worker would die starting. A notebook, ``python -c`` or an
+    interactive session has no script at all: what the task defines in ``__main__`` (a mechanism's
+    sweep function, its parameters' class) cannot reach a worker. Each said in one line, with the
+    cure, before any worker starts."""
     main = sys.modules.get("__main__")
     path = getattr(main, "__file__", None)
-    if path is None or getattr(getattr(main, "__spec__", None), "name", None) is not None:
-        return  # an interactive session or notebook (nothing to run), or a module run with -m
+    if getattr(getattr(main, "__spec__", None), "name", None) is not None:
+        return  # a module run with -m: importable by name
+    if path is None:  # a notebook, python -c, an interactive session
+        refs = [f"{m}.{n}" for m, n in (_reference(f) for f in (fn, setup) if f is not None) if m == "__main__"]
+        name = refs[0] if refs else _names_main(task)
+        if name is not None:
+            name = name if name.startswith("__main__.") else f"__main__.{name}"
+            raise WorkerError(f"worker processes cannot load {name}: it is defined in this session (a notebook, "
+                              "python -c or an interactive shell), which they cannot import; define the mechanism "
+                              "in an importable module, or run with jobs=1")
+        return
     if not os.path.isfile(path):
         raise WorkerError(f"worker processes cannot start from a script that is not a file ({path}: a script read "
                           "from standard input?): save it to a file and run that, or run with jobs=1")
@@ -278,7 +315,7 @@ class ProcessExecutor:
             return SerialExecutor().map(fn, tasks, setup=setup, shared=shared, progress=progress, weights=weights,
                                         first=first)
         log.debug("running %d tasks on %d processes (this one and %d spawned)", len(tasks), workers, workers - 1)
-        _check_main_importable()
+        check_main_importable(fn, setup, tasks[0])
         ctx = mp.get_context("spawn")
         fn_ref = _reference(fn)
         with _shared_file(shared) as shared_file:

@@ -51,8 +51,14 @@ def _fmt(x: float | None, digits: int) -> str:
     return f"{x:.{digits}f}"
 
 
+def any_paper(figures: list[Figure]) -> bool:
+    """Whether any figure stands beside a paper's value (else the tables show no paper columns)."""
+    return any(f.paper is not None for f in figures)
+
+
 def render_table(title: str, figures: list[Figure]) -> str:
-    """A plain-text table: quantity, value, unit, paper, difference, note."""
+    """A plain-text table: quantity, value, unit, paper, difference, note (no paper and
+    difference columns when no figure has a paper value)."""
     rows = [("quantity", "value", "unit", "paper", "diff", "note")]
     for f in figures:
         diff = f.difference
@@ -66,12 +72,13 @@ def render_table(title: str, figures: list[Figure]) -> str:
                 f.note,
             )
         )
+    shown = range(5) if any_paper(figures) else range(3)
     widths = [max(len(r[i]) for r in rows) for i in range(5)]
     lines = [title, "=" * len(title)]
     for i, r in enumerate(rows):
         cells = [r[0].ljust(widths[0])] + [r[k].rjust(widths[k]) if k != 2 else r[k].ljust(widths[k])
-                                           for k in range(1, 5)]
+                                           for k in shown if k > 0]
         lines.append("  ".join(cells) + ("  " + r[5] if r[5] else ""))
         if i == 0:
-            lines.append("  ".join("-" * w for w in widths) + "  ----")
+            lines.append("  ".join("-" * widths[k] for k in shown) + "  ----")
     return "\n".join(lines)

@@ -22,7 +22,8 @@ from __future__ import annotations
 
 import logging
 from abc import ABC, abstractmethod
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from typing import TYPE_CHECKING, Any, ClassVar
@@ -34,6 +35,7 @@ if TYPE_CHECKING:  # type names only: importing a mechanism costs neither CadQue
 
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
+    from gearcheck.drafting import Draft, NewInput
     from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body, MeshData
     from gearcheck.sweep.motion import Motion
@@ -143,6 +145,9 @@ class Mechanism(ABC):
     consistency_verdicts: ClassVar[tuple[str, ...]] = ("mesh_agrees_with_exact",)
     #: first seed of its random sets in `make fuzz` (disjoint streams: a set is reproducible alone)
     fuzz_seed_base: ClassVar[int] = 0
+    #: the numbers ``gearcheck new`` takes for a design of this mechanism (:mod:`gearcheck.drafting`);
+    #: empty: it offers no ``new``
+    new_inputs: ClassVar[tuple[NewInput, ...]] = ()
 
     # -- numpy only ---------------------------------------------------------------------------
     @abstractmethod
@@ -206,6 +211,15 @@ class Mechanism(ABC):
         or None to be evaluated variant by variant."""
         return None
 
+    # -- a design from a few numbers -----------------------------------------------------------
+    def new(self, inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
+        """A complete template from ``inputs`` (the numbers of :attr:`new_inputs` given, as the user
+        gave them) and ``overrides`` ({"section.key": value}: inputs to the derivation where it uses
+        them; :func:`gearcheck.drafting.draft` writes each into the template as given). Every dependent
+        value derived by the mechanism's design method, each with a note saying how (numpy only).
+        Raises :class:`gearcheck.params.common.ParamError` when the numbers admit no design."""
+        raise NotImplementedError(f"{self.name}: no `new`")
+
     # -- fuzzing ------------------------------------------------------------------------------
     def sample(self, data: dict, draw: Any) -> None:
         """Redraw the knobs of a template body in place (``draw``: a
@@ -215,6 +229,42 @@ class Mechanism(ABC):
     def fuzz_options(self, params: Any) -> dict:
         """Sweep options for a fuzzed design (cheaper sampling where a mechanism needs it)."""
         return {}
+
+
+# ------------------------------------------------------------------------------------------
+# A hook that raised
+
+
+class HookError(Exception):
+    """A mechanism's hook raised something other than a :class:`ParamError`: the mechanism, the
+    hook and the error in one line (the command line: exit 3, the traceback under ``-v``; the
+    original exception is the ``__cause__``)."""
+
+    def __init__(self, mechanism: str, hook: str, error: BaseException):
+        self.mechanism, self.hook, self.error = mechanism, hook, error
+        text = " ".join(str(error).split()) or "(no message)"
+        super().__init__(f"the {mechanism} mechanism's {hook} hook failed: {type(error).__name__}: {text}")
+
+
+@contextmanager
+def calling(mechanism: Mechanism | str, hook: str) -> Iterator[None]:
+    """Run a mechanism's hook: bad input (:class:`ParamError`) and gearcheck's own errors pass
+    through, anything else becomes a :class:`HookError` naming the mechanism and the hook."""
+    from gearcheck.params import ParamError
+
+    try:
+        yield
+    except (ParamError, HookError):
+        raise
+    except Exception as exc:
+        if type(exc).__module__.startswith("gearcheck.") and type(exc).__name__ in _OWN_ERRORS:
+            raise
+        name = mechanism if isinstance(mechanism, str) else mechanism.name
+        raise HookError(name, hook, exc) from exc
+
+
+# gearcheck's own errors that pass through a hook unchanged (they say what happened already)
+_OWN_ERRORS = frozenset({"WorkerError", "OutputError", "TooManyTriangles", "RunIncomplete"})
 
 
 # ------------------------------------------------------------------------------------------

@@ -22,8 +22,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
 
 from gearcheck.design import TOL_MAX_MM, TOL_MIN_MM
+from gearcheck.mechanism import calling
 from gearcheck.params import ParamError
-from gearcheck.results import CheckResult, Confirmation, Verdict
+from gearcheck.confirmation import confirm, confirmation_verdict  # noqa: F401 - part of the pipeline's API
+from gearcheck.results import CheckResult
 
 if TYPE_CHECKING:
     from gearcheck.cad.export import ExportedPart
@@ -56,6 +58,20 @@ def no_progress(_desc: str, _total: int | None = None, _unit: str = "") -> Itera
     yield _NoBar()
 
 
+def smallest_clearance(design: Design) -> Any:
+    """The mechanism's smallest clearance to resolve (its hook), which must be None or > 0 mm."""
+
+    from gearcheck.mechanism import HookError
+
+    with calling(design.impl, "smallest_clearance"):
+        clearance = design.impl.smallest_clearance(design.params)
+    if clearance is not None and not (math.isfinite(clearance.value_mm) and clearance.value_mm > 0.0):
+        raise HookError(design.mechanism, "smallest_clearance", ValueError(
+            f"returned Clearance({clearance.value_mm!r} mm): a clearance to resolve must be > 0 mm (None: the "
+            "check decides no non-zero clearance)"))
+    return clearance
+
+
 def check_tol(tol_mm: float | None) -> None:
     """``--tol`` within the range a mesh can be made and measured at."""
     if tol_mm is not None and not (TOL_MIN_MM <= tol_mm <= TOL_MAX_MM):
@@ -73,7 +89,7 @@ def mesh_plan(design: Design, tol_mm: float | None) -> MeshPlan:
     requested = float(given) if given is not None else float(design.impl.mesh_tol_mm)
     check_tol(requested)
     t0 = time.perf_counter()
-    clearance = design.impl.smallest_clearance(design.params)
+    clearance = smallest_clearance(design)
     log.info("stage plan: smallest clearance to decide: %s (%.2f s)",
              "none" if clearance is None else f"{clearance.value_mm:.5g} mm, {clearance.label}",
              time.perf_counter() - t0)
@@ -118,15 +134,22 @@ class BuildRun:
     manifest: dict
     files: list[Path] = field(default_factory=list)  # every file of the run (after the swap)
 
+    def __repr__(self) -> str:
+        return (f"<BuildRun {self.design.name}: {len(self.parts)} parts meshed at {self.tol_mm:g} mm, "
+                f"{len(self.files)} files in {self.folder}>")
+
 
 def build_parts(design: Design, progress: ProgressFactory = no_progress,
                 assembly: Assembly | None = None) -> tuple[Assembly, list[Part]]:
     """The assembly as data (given, or made from the parameters) and its solids (CadQuery), no
     files."""
     impl = design.impl
-    assembly = assembly if assembly is not None else impl.assembly(design.params)
+    if assembly is None:
+        with calling(impl, "assembly"):
+            assembly = impl.assembly(design.params)
     with progress(f"solids of {design.name}", len(assembly.names), "part") as bar:
-        parts = impl.parts(assembly)
+        with calling(impl, "parts"):
+            parts = impl.parts(assembly)
         bar.update(len(parts))
     if [p.name for p in parts] != assembly.names:
         raise RuntimeError(f"{impl.name}: parts() must return the assembly's parts in order, "
@@ -194,7 +217,8 @@ def _build_into(design: Design, folder: Path, tol_mm: float | None, progress: Pr
 
     plan = mesh_plan(design, tol_mm)
     tol = plan.tol_mm
-    assembly = design.impl.assembly(design.params)
+    with calling(design.impl, "assembly"):
+        assembly = design.impl.assembly(design.params)
     key, cached = _cached_cad(design, assembly, tol)
     if cached is not None:
         made, parts, meshed, step = cached
@@ -314,20 +338,24 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     check_poses(assembly, bodies)
     if mesh_plan is None:
         tol = max(float(b.error_bound_mm) for b in bodies.values())
-        mesh_plan = resolution.MeshPlan(tol, tol, True, impl.smallest_clearance(design.params))
+        mesh_plan = resolution.MeshPlan(tol, tol, True, smallest_clearance(design))
     executor = executor if executor is not None else make_executor(jobs)
-    plan = impl.plan(design.params, assembly, bodies, options)
+    with calling(impl, "plan"):
+        plan = impl.plan(design.params, assembly, bodies, options)
     log.info("stage sweep: %s, %d tasks on %d worker(s)", design.name, len(plan.tasks), executor.jobs)
     t0 = time.perf_counter()
-    with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar:
+    with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar, calling(impl, "plan's sweep task"):
         results = run_plan(executor, plan, bar.update)
     log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs,
              time.perf_counter() - t0)
-    outcome = plan.reduce(results)
+    with calling(impl, "plan's reduce"):
+        outcome = plan.reduce(results)
     rule = resolution.assess(mesh_plan, bodies)
     outcome.mesh_resolves = rule.resolves
-    verdicts = impl.verdicts(design.params, outcome)
-    report = impl.report(design.params, outcome, verdicts)
+    with calling(impl, "verdicts"):
+        verdicts = impl.verdicts(design.params, outcome)
+    with calling(impl, "report"):
+        report = impl.report(design.params, outcome, verdicts)
     timings = dict(outcome.timings)
     timings.setdefault("workers", executor.jobs)
     summary = dict(outcome.summary)
@@ -347,111 +375,6 @@ def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
             raise ValueError(f"missing body {spec.name!r}: expected the parts {assembly.names}")
         if not np.allclose(bodies[spec.name].pose, spec.pose, atol=1e-9):
             raise ValueError(f"{spec.name}: pose differs from the assembly's (built with other parameters?)")
-
-
-class _MeshPairs:
-    """The meshes at the worst poses, for :func:`confirm`: one FCL scene per pair of parts at
-    given scales, built once and posed for each worst pose that needs it. What it answers is
-    what :func:`gearcheck.sweep.tools.meshes_overlap` and
-    :func:`gearcheck.sweep.tools.mesh_nearest_midpoint` answer (the same meshes, scaled the same
-    way, the same FCL queries); only the bounding-volume trees are not rebuilt for each query."""
-
-    def __init__(self, bodies: Mapping[str, Body]):
-        self.bodies = bodies
-        self.scenes: dict[tuple, Any] = {}
-
-    def _posed(self, name_a: str, name_b: str, worst: Any) -> Any:
-        import numpy as np
-
-        from gearcheck.sweep.engine import Scene
-
-        key = (name_a, float(worst.scale_a), name_b, float(worst.scale_b))
-        if key not in self.scenes:
-            self.scenes[key] = Scene([self.bodies[name_a].scaled(worst.scale_a).mesh,
-                                      self.bodies[name_b].scaled(worst.scale_b).mesh])
-        scene = self.scenes[key]
-        scene.set_pose(name_a, np.asarray(worst.pose_a, float))
-        scene.set_pose(name_b, np.asarray(worst.pose_b, float))
-        return scene
-
-    def overlap(self, worst: Any) -> bool:
-        """Whether the two meshes intersect at the worst pose (whole parts; the sweep's answer
-        where it gave one)."""
-        if worst.mesh_overlap is not None:
-            return bool(worst.mesh_overlap)
-        a, b = (n.partition(".")[0] for n in (worst.part_a, worst.part_b))
-        return bool(self._posed(a, b, worst).collide(a, b))
-
-    def nearest_midpoint(self, worst: Any) -> Any:
-        """Where the meshes come closest (world frame; the sweep's answer where it gave one);
-        None for a feature of a part."""
-        import numpy as np
-
-        if "." in worst.part_a or "." in worst.part_b:
-            return None
-        if worst.mesh_nearest_midpoint is not None:
-            return np.asarray(worst.mesh_nearest_midpoint, float)
-        d = self._posed(worst.part_a, worst.part_b, worst).distance(worst.part_a, worst.part_b)
-        return 0.5 * (d.point_a + d.point_b)
-
-
-def confirm(result: CheckResult, parts: list[Part], bodies: Mapping[str, Body],
-            progress: ProgressFactory = no_progress) -> list[Confirmation]:
-    """Each worst pose re-measured on the exact B-rep (faces around the meshes' nearest points)."""
-    from gearcheck.cad.confirm import contact_state, exact_closest, exact_overlap_closest
-
-    by_name = {p.name: p for p in parts}
-    meshes = _MeshPairs(bodies)
-    log.info("stage confirm: %d worst poses on the exact B-rep", len(result.worst_poses))
-    out = []
-    with progress("exact B-rep distance at worst poses", len(result.worst_poses), "pose") as bar:
-        for worst in result.worst_poses:
-            bound = sum(bodies[n.partition(".")[0]].error_bound_mm for n in (worst.part_a, worst.part_b))
-            overlap = None
-            if worst.mesh_distance_mm <= 0.0 or meshes.overlap(worst):
-                # the meshes' nearest points mean nothing here: measure the whole solids
-                brep, overlap, point_a, point_b = exact_overlap_closest(by_name, worst)
-            else:
-                brep, point_a, point_b = exact_closest(by_name, worst, near=meshes.nearest_midpoint(worst))
-            contact, depth = "", math.nan
-            if brep <= bound:  # within the bound of zero: touching, overlapping, or clear?
-                contact, depth = contact_state(by_name, worst, brep, overlap, (point_a + point_b) / 2.0)
-            out.append(Confirmation(worst.label, worst.json_key, f"{worst.part_a} / {worst.part_b}",
-                                    worst.mesh_distance_mm, brep, bound, overlap,
-                                    tuple(float(v) for v in point_a), tuple(float(v) for v in point_b),
-                                    contact, depth))
-            bar.update(1)
-    keys = [c.key for c in out]
-    if len(set(keys)) != len(keys):  # summary.json keeps one entry per key: none may be lost
-        raise RuntimeError(f"worst poses must have distinct keys, got {keys}")
-    return out
-
-
-def confirmation_verdict(confirmations: list[Confirmation], rule: Any = None) -> Verdict:
-    """The exact B-rep confirmation as a verdict: at every worst pose the mesh and the exact
-    solids agree within the pair's mesh-error bound (distances at free poses; contact or overlap
-    where the meshes overlap). Where the meshes cannot resolve the design's smallest clearance
-    (``rule``: :class:`gearcheck.resolution.Resolution`), the B-rep figures are the evidence at
-    those poses, and the verdict says so."""
-    bad = [c for c in confirmations if not c.agrees]
-    parts = []
-    for c in confirmations:
-        if c.meshes_overlap:
-            if c.overlap_mm3 == c.overlap_mm3:  # not NaN
-                measure = f"common volume {c.overlap_mm3:.4g} mm³"
-            else:
-                measure = (f"no Boolean gave a common volume; sampled penetration depth {c.depth_mm * 1e3:.2f} µm"
-                           if math.isfinite(c.depth_mm) else "common volume not computed")
-            parts.append(f"{c.parts}: meshes overlap, exact distance {c.brep_mm:.2e} mm, solids "
-                         f"{c.contact or 'in contact'} ({measure})")
-        else:
-            parts.append(f"{c.parts}: mesh {c.mesh_mm:.5f} vs B-rep {c.brep_mm:.5f} mm (bound {c.bound_mm:.4f})")
-    unresolved = rule is not None and not rule.resolves
-    evidence = ("exact B-rep: the meshes cannot resolve the smallest clearance, so the B-rep distances at the "
-                "worst poses are the evidence there" if unresolved else "exact B-rep against the mesh sweep")
-    return Verdict.of("exact_confirmation", "worst poses confirmed on the exact B-rep", not bad,
-                      "; ".join(parts) if parts else "no worst pose to confirm",
-                      {"poses": float(len(confirmations)), "disagreeing": float(len(bad))}, evidence=evidence)
 
 
 # ------------------------------------------------------------------------------------------
@@ -478,6 +401,16 @@ class CheckRun:
     @property
     def verdicts(self):
         return self.result.verdicts
+
+    def __repr__(self) -> str:
+        from gearcheck.notebook import check_repr
+
+        return check_repr(self.result, self.build.design.name, self.folder)
+
+    def _repr_html_(self) -> str:
+        from gearcheck.notebook import check_html
+
+        return check_html(self.result, self.build.design.name, self.folder)
 
 
 def write_report(design: Design, folder: Path, result: CheckResult, manifest: dict, *,
@@ -573,6 +506,11 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
     from gearcheck.views import picture_process, plot_process
 
     check_tol(tol_mm)
+    if executor is None:  # worker processes must be able to load the mechanism: said before the build
+        from gearcheck.executor import capped_jobs, check_main_importable
+
+        if capped_jobs(jobs) > 1:
+            check_main_importable(type(design.impl), type(design.params))
     # the picture and plot processes start (VTK, matplotlib) while the CAD is built
     with RunFolder(folder) as txn, picture_process() as drawing, plot_process() as plotting:
         run = _build_into(design, txn.staging, tol_mm, progress, overrides)

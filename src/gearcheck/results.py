@@ -18,6 +18,8 @@ Level = Literal["pass", "warn", "fail"]
 LEVELS: tuple[Level, ...] = ("pass", "warn", "fail")
 #: the kinds of evidence a verdict can rest on, most exact first
 EVIDENCE = ("exact B-rep", "exact model", "mesh sweep", "analytical model")
+# a verdict's one line keeps at least this much of its key figure (and half the line) before it shortens it
+KEY_FIGURE_MIN = 48
 # Verdicts about gearcheck's own evidence, not about the design: the mesh sweep agreeing with the
 # exact model, the worst poses confirmed on the exact B-rep. Counted apart from the design's.
 SELF_CHECKS = frozenset({"mesh_agrees_with_exact", "exact_confirmation"})
@@ -65,6 +67,45 @@ class Verdict:
     def passed(self) -> bool:
         """True unless the level is "fail" (a warning does not fail a design)."""
         return self.level != "fail"
+
+    @property
+    def key_figure(self) -> str:
+        """The deciding figure in a few words: the shortfall where it fails or warns, else the
+        first clause of ``measured`` that has a figure in it (the whole sentence stays in
+        ``measured``)."""
+        text = self.shortfall if self.level != "pass" and self.shortfall else self.measured
+        for cut in ("; ", " — "):
+            head = text.split(cut, 1)[0]
+            if any(c.isdigit() for c in head):
+                text = head
+        return text
+
+    def line(self, width: int = 120, indent: int = 8) -> str:
+        """``label: key figure [evidence]`` in at most ``width − indent`` characters (the terminal's
+        one line per verdict): the evidence kind goes first; then the label is shortened while
+        the figure keeps at least half the line, then the figure."""
+        room = width - indent
+        kind = next((e for e in EVIDENCE if self.evidence.startswith(e)), "")
+        label, figure = self.label, self.key_figure
+        if kind and len(label) + len(figure) + len(kind) + 5 <= room:
+            return f"{label}: {figure} [{kind}]"
+        if len(label) + len(figure) + 2 <= room:
+            return f"{label}: {figure}"
+        keep = max(room - len(label) - 2, min(len(figure), max(KEY_FIGURE_MIN, room // 2)))
+        figure = figure if len(figure) <= keep else figure[: keep - 1] + "…"
+        if len(label) + len(figure) + 2 > room:
+            label = label[: room - len(figure) - 3] + "…"
+        return f"{label}: {figure}"
+
+    def __repr__(self) -> str:
+        from gearcheck.notebook import verdict_repr
+
+        return verdict_repr(self)
+
+    def _repr_html_(self) -> str:
+        from gearcheck.notebook import verdict_html
+
+        return verdict_html(self)
 
 
 @dataclass(frozen=True)
@@ -298,3 +339,13 @@ class CheckResult:
             text += f"; self-checks {k - checks['fail']} of {k} pass" + (
                 f" ({checks['warn']} with a warning)" if checks["warn"] else "")
         return text
+
+    def __repr__(self) -> str:
+        from gearcheck.notebook import check_repr
+
+        return check_repr(self, self.section)
+
+    def _repr_html_(self) -> str:
+        from gearcheck.notebook import check_html
+
+        return check_html(self, self.section)

@@ -35,6 +35,10 @@ NOTE_COLUMN_MIN = 30  # narrower than this, each note goes on its own line under
 NOTE_INDENT = 3
 MIN_WIDTH = 40  # narrower terminals are drawn at this width (the terminal wraps the rest)
 LEVEL_WORD = {"pass": "PASS", "warn": "WARN", "fail": "FAIL"}
+# Longest verdict line, on a terminal and piped (the whole sentence: report.html, summary.json)
+VERDICT_LINE = 120
+# calc's table when piped: this many columns (the notes wrap, or go under their quantity)
+CALC_WIDTH = 100
 LEVEL_STYLE = {"pass": "bold black on green", "warn": "bold black on yellow", "fail": "bold white on red"}
 
 
@@ -88,7 +92,8 @@ Examples:
   gearcheck demo --open
 
 Output: tables and coloured PASS / WARN / FAIL on a terminal, wrapped to its width (NO_COLOR:
-the same without colours); plain text when piped, not wrapped: one verdict per line, for grep.
+the same without colours); plain text when piped: one verdict per line (its key figure, at most
+120 characters; every sentence in full in report.html and summary.json), calc 100 columns wide.
 Progress bars with totals and the time left go to stderr when it is a terminal.
 Exit codes: 0 no verdict fails (warnings included), 1 a verdict fails, 2 bad input, 3 an internal
 error (a worker process killed; -v shows the traceback), 130 / 143 interrupted.
@@ -184,13 +189,16 @@ def calc_view(title: str, figures: list[Figure], screen: Screen) -> list[Rendera
     from rich.table import Table
     from rich.text import Text
 
+    from gearcheck.figures import any_paper
+
     rows = []
     for f in figures:
         diff = f.difference
         rows.append((f.label, _fmt(f.value, f.digits), f.unit, _fmt(f.paper, f.digits),
                      "" if diff is None else f"{diff:+.{f.digits}f}", f.note))
     heads = ("quantity", "value", "unit", "paper", "diff", "note")
-    longest = [max(len(r[i]) for r in [heads, *rows]) for i in range(6)]
+    paper = any_paper(figures)  # else no paper and diff columns (no figure stands beside a paper's value)
+    longest = [max(len(r[i]) for r in [heads, *rows]) if paper or i not in (3, 4) else 0 for i in range(6)]
     quantity_w = note_w = None
     notes_under = False
     if screen.width is not None:  # the quantity keeps its width while the notes wrap
@@ -205,17 +213,19 @@ def calc_view(title: str, figures: list[Figure], screen: Screen) -> list[Rendera
     table.add_column("quantity", width=quantity_w, overflow="fold")
     table.add_column("value", justify="right", no_wrap=True, style="bold")
     table.add_column("unit", no_wrap=True)
-    table.add_column("paper", justify="right", no_wrap=True, style="cyan")
-    table.add_column("diff", justify="right", no_wrap=True, style="yellow")
+    if paper:
+        table.add_column("paper", justify="right", no_wrap=True, style="cyan")
+        table.add_column("diff", justify="right", no_wrap=True, style="yellow")
     if not notes_under:
         table.add_column("note", width=note_w, overflow="fold", style="dim")
     for row in rows:
+        cells = row[:5] if paper else row[:3]
         if not notes_under:
-            table.add_row(*row)
+            table.add_row(*cells, row[5])
             continue
-        table.add_row(*row[:5])
+        table.add_row(*cells)
         if row[5]:
-            table.add_row(Padding(Text(row[5], style="dim italic"), (0, 0, 0, NOTE_INDENT)), "", "", "", "")
+            table.add_row(Padding(Text(row[5], style="dim italic"), (0, 0, 0, NOTE_INDENT)), *[""] * (len(cells) - 1))
     return [Text(title, style="bold"), table]
 
 
@@ -237,32 +247,20 @@ def _headline(result: CheckResult, name: str, folder: Path, screen: Screen) -> A
 
 
 def verdicts_view(result: CheckResult, name: str, folder: Path, screen: Screen) -> list[RenderableType]:
-    """The design's level, then one entry per verdict: PASS / WARN / FAIL, what was checked,
-    what was measured, the evidence that decided it. Wrapped under its level word on a terminal;
-    one line per verdict otherwise."""
-    from rich.table import Table
+    """The design's level, then one line per verdict: PASS / WARN / FAIL, what was checked and its
+    key figure (the shortfall where it fails or warns), within 120 columns or the terminal's width;
+    the whole sentence and its evidence are in report.html and summary.json (``verdict_measured``,
+    ``verdict_evidence``)."""
     from rich.text import Text
 
     out: list[RenderableType] = [_headline(result, name, folder, screen)]
-    if screen.width is None:
-        for v in result.verdicts:
-            line = Text("  ")
-            line.append_text(badge(v.level, screen))
-            line.append(f"  {v.label}: {v.measured}" + (f" [{v.evidence}]" if v.evidence else ""))
-            out.append(line)
-        return out
-    grid = Table.grid(padding=(0, 2, 0, 0), pad_edge=False)
-    grid.add_column(no_wrap=True)
-    grid.add_column(overflow="fold")
-    for i, v in enumerate(result.verdicts):
-        body = Text(v.label, style="bold")
-        body.append(f"\n{v.measured}")
-        if v.evidence:
-            body.append(f"\nevidence: {v.evidence}", style="dim")
-        if i:
-            grid.add_row("", "")
-        grid.add_row(badge(v.level, screen), body)
-    return [*out, _indented(grid)]
+    width = min(VERDICT_LINE, screen.width or VERDICT_LINE)
+    for v in result.verdicts:  # one line each: the key figure; the whole sentence is in the report
+        line = Text("  ")
+        line.append_text(badge(v.level, screen))
+        line.append(f"  {v.line(width, indent=10 if screen.color else 8)}")
+        out.append(line)
+    return out
 
 
 def _indented(renderable: RenderableType) -> RenderableType:
@@ -275,7 +273,8 @@ def calc_pointer(figures: list[Figure], path: Path) -> str:
     """One line in place of the calc table: how many figures, how many beside the paper's, where
     the table is."""
     paper = sum(f.paper is not None for f in figures)
-    return f"{len(figures)} figures ({paper} beside the paper's values), table in {path}"
+    beside = f" ({paper} beside the paper's values)" if paper else ""
+    return f"{len(figures)} figures{beside}, table in {path}"
 
 
 def _size(n: float) -> str:

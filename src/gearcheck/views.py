@@ -49,7 +49,10 @@ def scene_of(design: Any, assembly: Any, parts: list, result: CheckResult | None
     from gearcheck.cad.display import display_parts
 
     shown: list[DisplayPart] = display_parts(parts)
-    frames, label = design.impl.display_frames(design.params, assembly)
+    from gearcheck.mechanism import calling
+
+    with calling(design.impl, "display_frames"):
+        frames, label = design.impl.display_frames(design.params, assembly)
     return Scene(design.name, shown, worst_views(result) if result is not None else [], list(frames), label)
 
 

@@ -27,13 +27,16 @@ def _plain(value):
 
 def summary_json(result: CheckResult) -> str:
     """``{section: {...summary..., "verdicts": {name: 1/0}, "verdict_levels": {name: "pass" |
-    "warn" | "fail"}, "verdict_evidence": {name: text}, "verdict_pass": 1/0, "verdict_warnings": n,
+    "warn" | "fail"}, "verdict_evidence": {name: text}, "verdict_measured": {name: text}, "verdict_pass": 1/0,
+    "verdict_warnings": n,
     "verdict_counts": {"design" | "self_checks": {level: n}},
     "exact_confirmation": {key: {mesh_mm, brep_mm, bound_mm}}}}`` with sorted keys."""
     body = dict(result.summary)
     body["verdicts"] = {v.name: int(v.passed) for v in result.verdicts}
     body["verdict_levels"] = {v.name: v.level for v in result.verdicts}
     body["verdict_evidence"] = {v.name: v.evidence for v in result.verdicts}
+    # the whole sentence of each verdict (the terminal shows its key figure only)
+    body["verdict_measured"] = {v.name: v.measured for v in result.verdicts}
     body["verdict_pass"] = int(result.passed)
     body["verdict_warnings"] = sum(v.level == "warn" for v in result.verdicts)
     body["verdict_counts"] = result.counts()

@@ -12,8 +12,12 @@ Layout of the file (glTF 2.0, written here with numpy and json: deterministic by
 * with motion frames, an animation ``motion`` stepping the moving parts of scene 0 through the
   frames (one key frame per second, linear).
 
-Lengths are millimetres, not glTF's metres: ``asset.extras.units`` says so (scale by 0.001 on
-import where a tool assumes metres). Colours are each part's material colour (sRGB) as PBR base
+Units and axes as glTF specifies: metres, Y up. Each scene holds one root node (``<scene>_m_yup``)
+whose matrix scales gearcheck's millimetres to metres and turns its Z-up frame to Y up (x, y, z) →
+(x, z, −y); below it every node keeps the part's pose in millimetres, so the animation and the
+extras' figures (``distance_mm``, ``point_a`` …, in the Z-up millimetre frame of the STEP and the
+STL) read as everywhere else in gearcheck. Blender, three.js and other viewers then show a 240 mm
+sprocket as 0.24 m, standing the right way up. Colours are each part's material colour (sRGB) as PBR base
 colour (linear, as glTF requires). Normals are per vertex within each B-rep face (the display
 mesh keeps each face's own vertices), so faces shade smoothly and their edges stay sharp.
 """
@@ -35,6 +39,8 @@ CHUNK_BIN = 0x004E4942
 FLOAT, UINT32 = 5126, 5125
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 MODE_LINES, MODE_TRIANGLES = 1, 4
+# scene root: millimetres → metres, Z up → Y up ((x, y, z) → (x, z, −y)), as glTF specifies
+TO_GLTF = np.array([[1e-3, 0.0, 0.0, 0.0], [0.0, 0.0, 1e-3, 0.0], [0.0, -1e-3, 0.0, 0.0], [0.0, 0.0, 0.0, 1.0]])
 # closest-point markers: radius as a fraction of the assembly's bounding-box diagonal
 MARKER_FRACTION = 0.006
 MARKER_RGB = {"closest_a": (0.85, 0.1, 0.1), "closest_b": (0.1, 0.3, 0.9), "gap": (0.95, 0.65, 0.0)}
@@ -220,7 +226,8 @@ def glb_bytes(scene: Scene) -> bytes:
     """The scene as a GLB file (bytes): see the module docstring for its layout."""
     w = _Writer()
     w.tree["asset"] = {"version": "2.0", "generator": f"gearcheck {__version__}",
-                       "extras": {"units": "mm", "note": "lengths in millimetres (glTF assumes metres)"}}
+                       "extras": {"units": "m, Y up (each scene's root node scales gearcheck's Z-up millimetres)",
+                                  "figures": "extras' *_mm and points: millimetres in the Z-up frame of the STEP"}}
     meshes: dict[tuple[int, int, tuple], int] = {}
     part_mesh: dict[str, int] = {}
     for p in scene.parts:
@@ -239,8 +246,11 @@ def glb_bytes(scene: Scene) -> bytes:
             out.append(w.node(prefix + p.name, part_mesh[p.name], _scaled(pose, scale), extras))
         return out
 
+    def rooted(name: str, children: list[int]) -> list[int]:
+        return [w.node(f"{name}_m_yup", None, TO_GLTF, children=children)]
+
     roots = part_nodes("", None)
-    scenes = [{"name": scene.name, "nodes": roots, "extras": {"units": "mm"}}]
+    scenes = [{"name": scene.name, "nodes": rooted(scene.name, roots), "extras": {"units": "m"}}]
 
     radius = MARKER_FRACTION * _extent(scene)
     sphere = icosphere(radius)
@@ -259,7 +269,7 @@ def glb_bytes(scene: Scene) -> bytes:
             line = w.mesh(prefix + "gap", np.array([a, b], np.float32), np.array([[0, 1]], np.uint32),
                           w.material("gap", MARKER_RGB["gap"], 0.0), normals=False)
             nodes.append(w.node(prefix + "gap", line))
-        scenes.append({"name": f"worst_{i}", "nodes": nodes, "extras": _worst_extras(view)})
+        scenes.append({"name": f"worst_{i}", "nodes": rooted(f"worst_{i}", nodes), "extras": _worst_extras(view)})
     w.tree["scenes"] = scenes
     w.tree["scene"] = 0
     if scene.frames:

@@ -172,7 +172,8 @@ def _differences_notice(comparisons: Sequence[Comparison]) -> str:
     others = len(major) - len(paper)
     if not major:
         return ""
-    more = (f"{'Also ' if paper else ''}{others} row{'s' if others > 1 else ''} without a paper figure where the "
+    without = " without a paper figure" if any(c.paper is not None for c in comparisons) else ""
+    more = (f"{'Also ' if paper else ''}{others} row{'s' if others > 1 else ''}{without} where the "
             f"exact model or the geometry differs from the analytical model by more than {compare.MAJOR:.0%}: "
             "marked in the <a href='#comparisons'>table</a>, each with its reason.") if others else ""
     if not paper:
@@ -221,32 +222,43 @@ def _verdicts(result: CheckResult) -> str:
     return "<h2 id='verdicts'>Verdicts</h2>" + _table(["claim", "result", "measured", "decided by"], rows)
 
 
+def _comparisons_title(comparisons: Sequence[Comparison]) -> str:
+    """The table's title: the paper named only when a row stands beside a paper's figure."""
+    return "Paper, model, geometry" if any(c.paper is not None for c in comparisons) else "Model, geometry"
+
+
 def _comparisons(comparisons: Sequence[Comparison]) -> str:
     if not comparisons:
         return ""
-    headers = ["figure", "unit", "paper", "analytical model", "exact model", "geometry (mesh sweep)", "difference",
-               "why they differ"]
+    paper = any(c.paper is not None for c in comparisons)  # else no paper column (another design)
+    headers = ["figure", "unit", *(["paper"] if paper else []), "analytical model", "exact model",
+               "geometry (mesh sweep)", "difference", "why they differ"]
     rows = []
     for c in comparisons:
         flags = {d.column: d.level for d in compare.differences(c)}
         sign = {"min": "≥ ", "max": "≤ ", "value": ""}[c.paper_is] if c.paper is not None else ""
         unit = f" ({c.unit})" if c.unit else ""
-        cells = [_td("figure", _e(c.label)), _td("unit", _e(c.unit), "unit"),
-                 _td("paper" + unit, _e(sign + compare.paper_text(c.paper)), "num")]
-        for column, header in zip(("model", "exact", "geometry"), headers[3:6], strict=True):
+        cells = [_td("figure", _e(c.label)), _td("unit", _e(c.unit), "unit")]
+        if paper:
+            cells.append(_td("paper" + unit, _e(sign + compare.paper_text(c.paper)), "num"))
+        for column, header in zip(("model", "exact", "geometry"), headers[-5:-2], strict=True):
             cls = "num" + (f" {flags[column]}" if flags.get(column) else "")
             cells.append(_td(header + unit, compare.value_text(getattr(c, column), c.digits), cls))
         level = compare.worst(c)
         cells.append(_td("difference", compare.difference_cell(c), level))
         cells.append(_td("why they differ", _e(c.note)))
         rows.append(f"<tr>{''.join(cells)}</tr>")
+    beyond = (f"beyond that the difference is shown, marked beyond {compare.MINOR:.0%}, and marked strongly beyond "
+              f"{compare.MAJOR:.0%}")
     intro = ("<p class='small'>Paper figures as printed (≥/≤: a bound the design must meet). Each computed "
              "column is compared with the paper, or, where it prints none, with the analytical model: within what "
              "the shown figures cannot tell apart (the paper's last printed digit, the column's last shown digit "
-             "and, for the mesh sweep, its error bound) it agrees; beyond that the difference is shown, marked "
-             f"beyond {compare.MINOR:.0%}, and marked strongly beyond {compare.MAJOR:.0%} or on the wrong side of "
-             "a bound.</p>")
-    return "<h2 id='comparisons'>Paper, model, geometry</h2>" + intro + _table(headers, rows)
+             f"and, for the mesh sweep, its error bound) it agrees; {beyond} or on the wrong side of a bound.</p>"
+             if paper else
+             "<p class='small'>Each computed column is compared with the analytical model (else the exact model): "
+             "within what the shown figures cannot tell apart (the column's last shown digit and, for the mesh "
+             f"sweep, its error bound) it agrees; {beyond}.</p>")
+    return f"<h2 id='comparisons'>{_comparisons_title(comparisons)}</h2>" + intro + _table(headers, rows)
 
 
 def _reading(k: Confirmation) -> str:
@@ -370,7 +382,7 @@ def _files(files: Sequence[str]) -> str:
 
 def _toc(result: CheckResult, geometry: bool, inputs: bool, files: bool) -> str:
     links = [("geometry", "Geometry", geometry), ("verdicts", "Verdicts", True),
-             ("comparisons", "Paper, model, geometry", bool(result.comparisons)),
+             ("comparisons", _comparisons_title(result.comparisons), bool(result.comparisons)),
              ("exact", "Exact B-rep", bool(result.confirmations)), ("plots", "Plots", bool(result.plots)),
              ("notes", "Notes", bool(result.notes)), ("inputs", "Inputs", inputs), ("files", "Files", files)]
     return "<nav class='toc'>" + " ".join(f"<a href='#{i}'>{t}</a>" for i, t, shown in links if shown) + "</nav>"

@@ -18,6 +18,7 @@ import io
 import math
 import re
 import textwrap
+from typing import Any
 
 from gearcheck.report.child import ChildOwner
 from gearcheck.results import Plot
@@ -37,7 +38,7 @@ LABEL_CHARS = 34  # a y-axis label wraps at this many characters (the axes' heig
 TAG_SPACING = 0.035
 TAG_Y = 1.035  # tags sit just above the axes (axes fraction)
 FIGSIZE = (6.8, 3.6)  # inches; the SVG scales to the page, the fonts with it
-RC = {"svg.hashsalt": "gearcheck", "svg.fonttype": "none", "font.size": 10.0, "axes.titlesize": 11.5,
+RC: dict[str, Any] = {"svg.hashsalt": "gearcheck", "svg.fonttype": "none", "font.size": 10.0, "axes.titlesize": 11.5,
       "axes.labelsize": 10.5, "xtick.labelsize": 9.5, "ytick.labelsize": 9.5}
 _UNITS = {"deg": "°", "arcmin": "′"}
 

@@ -48,6 +48,16 @@ class StudyResult:
     def to_pandas(self):
         return self.table.to_pandas()
 
+    def __repr__(self) -> str:
+        from gearcheck.notebook import study_repr
+
+        return study_repr(self)
+
+    def _repr_html_(self) -> str:
+        from gearcheck.notebook import study_html
+
+        return study_html(self)
+
 
 def scheduler_timeout() -> float:
     """Seconds a Dask scheduler given by address may take to answer (:data:`SCHEDULER_TIMEOUT_S`,
@@ -335,13 +345,16 @@ def study(path: str | Path, *, samples: int | None = None, seed: int | None = No
             import pyarrow.parquet as pq
 
             from gearcheck import __version__
+            from gearcheck.design import from_data
             from gearcheck.studies.report import render
 
             sink = pa.BufferOutputStream()
             pq.write_table(tab, sink, compression="zstd")
             atomic_write_bytes(folder / "results.parquet", sink.getvalue().to_pybytes())
             atomic_write_text(folder / "summary.json", _json(summary))
-            atomic_write_text(folder / "report.html", render(spec, summary, tab, study_file=shown(path)))
+            labels = {f.key: f.label for f in from_data(base.data).calc().figures}
+            atomic_write_text(folder / "report.html", render(spec, summary, tab, study_file=shown(path),
+                                                             labels=labels))
             from gearcheck.pipeline import seal
 
             seal(folder, {"gearcheck_version": __version__, "kind": "study", "study": shown(path),

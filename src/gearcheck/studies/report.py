@@ -12,11 +12,14 @@ import numpy as np
 
 from gearcheck import __version__
 from gearcheck.report.html import CSS, figure_svg
+from gearcheck.report.plots import RC
 from gearcheck.studies import stats
 from gearcheck.studies.spec import StudySpec
 
 EXTRA_CSS = """
 .plot svg { max-width: 100%; height: auto; }
+.info { background: #eef3fb; color: #1d3a66; border: 1px solid #b7c9e6; }
+.banner.info ul { font-size: 0.72em; }
 td.p { font-weight: 600; }
 """
 
@@ -39,18 +42,42 @@ def _plt():
     import matplotlib
 
     matplotlib.use("Agg")
-    matplotlib.rcParams["svg.hashsalt"] = "gearcheck"
-    matplotlib.rcParams["svg.fonttype"] = "none"  # text stays text: searchable
     import matplotlib.pyplot as plt
 
+    # the check report's plot settings (same fonts, text stays text, a fixed hash salt), and 1.656 on
+    # an axis, never "+1.656" and an offset
+    settings: dict[Any, Any] = {**RC, "axes.formatter.useoffset": False}
+    plt.rcParams.update(settings)
     return plt
+
+
+_UNIT_SUFFIX = {"_pct": "%", "_mm": "mm", "_deg": "°", "_arcmin": "′", "_um": "µm", "_C": "°C", "_K": "K",
+                "_mm3": "mm³"}
+_LEVEL_WORD = {"analytical": "paper's model", "exact": "exact model", "check": "check", "in": "input"}
+
+
+def label_of(key: str, labels: dict[str, str] | None = None) -> str:
+    """A column key as an axis label: the figure's own label where the template's calc has it, else
+    its words, with the unit from the key's suffix and the level in words:
+    "exact.wear_margin_pct" → "wear margin (%), exact model"."""
+    level, _, name = key.partition(".") if "." in key else ("", "", key)
+    unit = next((u for suffix, u in _UNIT_SUFFIX.items() if name.endswith(suffix)), "")
+    bare = name[: -len(next(sfx for sfx, u in _UNIT_SUFFIX.items() if u == unit and name.endswith(sfx)))] \
+        if unit else name
+    words = (labels or {}).get(name) or bare.replace("_", " ")
+    text = f"{words} ({unit})" if unit and f"({unit})" not in words else words
+    return f"{text}, {_LEVEL_WORD.get(level, level)}" if level else text
+
+
+def _legend_below(ax) -> None:
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.28), ncol=2, frameon=False, fontsize=8.5)
 
 
 def _column(tab, name: str) -> np.ndarray:
     return np.asarray(tab.column(name).to_numpy(zero_copy_only=False), float)
 
 
-def _histograms(spec: StudySpec, summary: dict, tab) -> list[str]:
+def _histograms(spec: StudySpec, summary: dict, tab, labels: dict[str, str]) -> list[str]:
     valid = np.asarray(tab.column("valid").to_numpy(zero_copy_only=False), bool)
     limits: dict[str, list[tuple[str, float]]] = {}
     for name, f in summary["failures"].items():
@@ -69,22 +96,33 @@ def _histograms(spec: StudySpec, summary: dict, tab) -> list[str]:
         ax.hist(v, bins=min(60, max(10, int(math.sqrt(v.size)))), color="#6b8fc7", edgecolor="white")
         for (label, x), colour in zip(limits.get(key, []), ("#b03030", "#2f7d3a", "#7a5200", "#444"), strict=False):
             ax.axvline(x, color=colour, ls="--", lw=1.4, label=f"{label} ({x:.4g})")
-        ax.set_title(f"{key}: {v.size} variants")
-        ax.set_xlabel(key)
+        ax.set_title(f"{label_of(key, labels)}: {v.size} valid variants")
+        ax.set_xlabel(label_of(key, labels))
         ax.set_ylabel("variants")
         ax.grid(True, alpha=0.3)
         if limits.get(key):
-            ax.legend(fontsize=8)
+            _legend_below(ax)
         out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
     return out
 
 
-def _failure_curves(spec: StudySpec, summary: dict, tab) -> list[str]:
+# A P(fail)-against-input curve is drawn only from this many variants with an output (equal-count
+# bins of at least 40: each bin's 95 % interval then spans at most about ±0.15 around p = 0.5);
+# below it the curve would be noise, and the sensitivity table ranks the inputs instead.
+CURVE_MIN_VARIANTS = 200
+
+
+def _failure_curves(spec: StudySpec, summary: dict, tab) -> tuple[list[str], list[str]]:
+    """The plots, and a line for each failure too sparse to draw."""
     valid = np.asarray(tab.column("valid").to_numpy(zero_copy_only=False), bool)
-    out = []
+    out, skipped = [], []
     plt = _plt()
     for name, f in summary["failures"].items():
         if f["failures"] == 0:
+            continue
+        if f["variants"] < CURVE_MIN_VARIANTS:
+            skipped.append(f"P({name}) against each input: {f['variants']} variants, fewer than the "
+                           f"{CURVE_MIN_VARIANTS} a curve needs (see the ranking above)")
             continue
         y = _column(tab, f["output"])
         seen = valid & np.isfinite(y)
@@ -92,46 +130,92 @@ def _failure_curves(spec: StudySpec, summary: dict, tab) -> list[str]:
         inputs = [i.key for i in spec.inputs]
         cols = min(3, len(inputs))
         rows = math.ceil(len(inputs) / cols)
-        fig, axes = plt.subplots(rows, cols, figsize=(9.5, 2.4 * rows), dpi=100, squeeze=False)
+        fig, axes = plt.subplots(rows, cols, figsize=(9.5, 2.6 * rows), dpi=100, squeeze=False)
         for ax, field in zip(axes.flat, inputs, strict=False):
             x = _column(tab, f"in.{field}")[seen]
-            c, frac, _counts = stats.failure_curve(x, failed[seen])
-            ax.plot(c, frac, "o-", ms=3)
-            ax.set_title(field, fontsize=8)
+            c, frac, counts = stats.failure_curve(x, failed[seen])
+            bounds = np.array([stats.wilson(int(round(p * n)), int(n))[1:] for p, n in zip(frac, counts, strict=True)])
+            ax.errorbar(c, frac, yerr=[frac - bounds[:, 0], bounds[:, 1] - frac], fmt="o-", ms=3, lw=1.2,
+                        capsize=2, color="#3d6fb6")
+            unit = next((i.unit for i in spec.inputs if i.key == field), "")
+            ax.set_xlabel(f"{field} ({unit})" if unit else field, fontsize=9)
             ax.set_ylim(-0.02, 1.02)
             ax.grid(True, alpha=0.3)
         for ax in list(axes.flat)[len(inputs):]:
             ax.axis("off")
-        fig.suptitle(f"P({name}) against each input (equal-count bins)", fontsize=10)
+        axes.flat[0].set_ylabel(f"P({name})")
+        fig.suptitle(f"P({name}) against each input: equal-count bins, 95 % Wilson intervals", fontsize=10.5)
         out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
-    return out
+    return out, skipped
 
 
-def _paper_vs_exact(tab) -> list[str]:
+def _paper_vs_exact(tab, labels: dict[str, str]) -> tuple[list[str], list[str]]:
+    """Where the paper's model and the exact model give the same figure: a histogram of their
+    difference (exact − paper) over the variants (an identity plot shows nothing at this scale); a
+    line for each figure on which they agree to 1e-9 everywhere."""
     names = tab.column_names
     pairs = sorted(k[len("analytical."):] for k in names
                    if k.startswith("analytical.") and f"exact.{k[len('analytical.'):]}" in names)
-    out = []
+    out, same = [], []
     plt = _plt()
     for key in pairs:
         a, e = _column(tab, f"analytical.{key}"), _column(tab, f"exact.{key}")
         both = np.isfinite(a) & np.isfinite(e)
         if both.sum() < 2:
             continue
-        fig, ax = plt.subplots(figsize=(5.5, 4.6), dpi=100)
-        ax.plot(a[both], e[both], "o", ms=3, alpha=0.7)
-        lo, hi = float(min(a[both].min(), e[both].min())), float(max(a[both].max(), e[both].max()))
-        ax.plot([lo, hi], [lo, hi], "-", color="0.5", lw=1, label="exact = paper model")
-        ax.set_xlabel(f"paper's model: {key}")
-        ax.set_ylabel(f"exact model: {key}")
-        ax.set_title(f"{key}: {int(both.sum())} variants; mean difference {float(np.mean(e[both] - a[both])):.4g}")
+        d = e[both] - a[both]
+        scale = max(float(np.max(np.abs(a[both]))), 1e-12)
+        if float(np.max(np.abs(d))) <= 1e-9 * scale:
+            same.append(f"{label_of(key, labels)}: the exact model equals the paper's on all {int(both.sum())} "
+                        "variants")
+            continue
+        fig, ax = plt.subplots(figsize=(9.0, 3.0), dpi=100)
+        ax.hist(d, bins=min(40, max(8, int(math.sqrt(d.size)))), color="#8a6bc7", edgecolor="white")
+        ax.axvline(0.0, color="0.35", lw=1.0)
+        ax.set_xlabel(f"exact model − paper's model: {label_of(key, labels)}")
+        ax.set_ylabel("variants")
+        ax.set_title(f"{label_of(key, labels)}: exact − paper, mean {float(np.mean(d)):.4g}, "
+                     f"range {float(d.min()):.4g} to {float(d.max()):.4g} ({int(both.sum())} variants)")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
         out.append(f"<div class='plot'>{figure_svg(fig, fit_width=True)}</div>")
-    return out
+    return out, same
 
 
-def render(spec: StudySpec, summary: dict, tab, *, study_file: str) -> str:
+def _drawn(summary: dict) -> str:
+    """What the study draws, in words: each input's distribution."""
+    out = []
+    for key, i in summary["inputs"].items():
+        unit = f" {i['unit']}" if i.get("unit") else ""
+        if i["distribution"] == "uniform":
+            shape = f"uniform {_fmt(i.get('low'))} to {_fmt(i.get('high'))}{unit}"
+        else:
+            centre = f"mean {_fmt(i['mean'])}, " if "mean" in i else ""
+            shape = f"{i['distribution']} {centre}sd {_fmt(i.get('sd'))}{unit}"
+        out.append(f"{key} {shape}")
+    return "; ".join(out)
+
+
+def _headline(summary: dict) -> str:
+    """The failure counts against what the study draws: a study measures how often each failure
+    happens over its inputs' distributions (one drawn past a limit on purpose finds it), so the
+    headline states the counts and the inputs, not a pass or a fail."""
+    n = summary["valid"]
+    items = []
+    for name, f in summary["failures"].items():
+        if not f["variants"]:
+            items.append(f"<li><code>{html.escape(name)}</code>: not evaluated</li>")
+            continue
+        items.append(f"<li><code>{html.escape(name)}</code> ({html.escape(f['label'])}): {f['failures']} of "
+                     f"{f['variants']} valid variants, {_pct(f['probability'])} ({_pct(f['ci95_low'])} – "
+                     f"{_pct(f['ci95_high'])})</li>")
+    seen = sum(1 for f in summary["failures"].values() if f["failures"])
+    return (f"<div class='banner info'>{seen} of {len(summary['failures'])} failure modes occur in {n} valid "
+            f"variants drawn from: {html.escape(_drawn(summary))}<ul>{''.join(items)}</ul></div>")
+
+
+def render(spec: StudySpec, summary: dict, tab, *, study_file: str, labels: dict[str, str] | None = None) -> str:
+    """The page. ``labels``: the template's calc figure labels by key (the plots' axis labels)."""
+    labels = labels or {}
     title = f"gearcheck study: {spec.title}"
     parts = ["<!doctype html><html lang='en'><head><meta charset='utf-8'>",
              "<meta name='viewport' content='width=device-width, initial-scale=1'>",
@@ -141,10 +225,7 @@ def render(spec: StudySpec, summary: dict, tab, *, study_file: str) -> str:
              f"<code>{html.escape(summary['template'])}</code> · {summary['samples']} variants ({summary['sampler']}, "
              f"seed {summary['seed']}) · {summary['valid']} valid, {summary['rejected']} rejected by validation · "
              f"exact model on {summary['exact_variants']} · gearcheck {__version__}</p>"]
-    failing = [f for f in summary["failures"].values() if f["failures"] > 0]
-    level = "fail" if failing else "pass"
-    parts.append(f"<div class='banner {level}'>{len(failing)} of {len(summary['failures'])} failure modes "
-                 f"seen in {summary['valid']} valid variants</div>")
+    parts.append(_headline(summary))
     parts.append("<h2>Probability of each failure</h2><p class='meta'>Over the valid variants (those the "
                  "template accepts: in spec), as the headline counts; beside it, over every variant drawn, the ones "
                  "rejected as out of spec counted as failures of their own kind.</p><table><tr><th>failure</th>"
@@ -188,15 +269,17 @@ def render(spec: StudySpec, summary: dict, tab, *, study_file: str) -> str:
         parts.append("</table>")
 
     parts.append("<h2>Distributions</h2>")
-    parts += _histograms(spec, summary, tab)
-    curves = _failure_curves(spec, summary, tab)
-    if curves:
+    parts += _histograms(spec, summary, tab, labels)
+    curves, sparse = _failure_curves(spec, summary, tab)
+    if curves or sparse:
         parts.append("<h2>Probability of failure against each input</h2>")
         parts += curves
-    comparisons = _paper_vs_exact(tab)
-    if comparisons:
+        parts += [f"<p class='meta'>{html.escape(line)}.</p>" for line in sparse]
+    comparisons, same = _paper_vs_exact(tab, labels)
+    if comparisons or same:
         parts.append("<h2>The paper's model against the exact model</h2>")
         parts += comparisons
+        parts += [f"<p class='meta'>{html.escape(line)}.</p>" for line in same]
     if summary["paper"]:
         parts.append("<h2>The paper's measurements beside the distributions</h2><table><tr><th>measured</th>"
                      "<th>output</th><th>paper</th><th>study p05 – p50 – p95</th></tr>")

@@ -2,8 +2,10 @@
 
 ``calc(params)`` runs the paper's model, eqs (1)–(11) (the lost (1), (10), (11) reconstructed,
 see :mod:`.analysis` and docs/differential.md), and returns figures beside the paper's numbers.
-Paper values are attached only at the paper's own conditions (25 → −65 °C, 0.10 mm shim), so an
-override never shows a paper number beside a figure it does not describe.
+Paper values are attached only to the paper's own unit (:func:`.paper.is_paper_design`: the gears,
+thinning, materials, dimensions and calibration of the shipped template) and only at the paper's
+own conditions (a 90 K drop, its 0.10 mm shim), so another design or an override never shows a
+paper number beside a figure it does not describe.
 
 The paper's model is first order and linear in the temperature; beside it ``calc`` gives the
 exact-flank model (no mesh, :mod:`.temperature`) at the template's named temperatures and the
@@ -19,6 +21,7 @@ import math
 from gearcheck.figures import Figure
 from gearcheck.mechanisms.differential import analysis
 from gearcheck.mechanisms.differential.analysis import analyse_params
+from gearcheck.mechanisms.differential.paper import is_paper_design
 from gearcheck.mechanisms.differential.params import Params, shim_key
 from gearcheck.mechanisms.differential.temperature import STATE_TEXT, RangeCheck, range_check
 
@@ -40,7 +43,7 @@ PAPER = {
 PAPER_TEMPERATURE_DROP_K = 90.0  # 25 °C → −65 °C
 PAPER_SHIM_MM = 0.10
 
-__all__ = ["MESH_TOL_MM", "PAPER", "Params", "analyse_params", "calc"]
+__all__ = ["MESH_TOL_MM", "PAPER", "Params", "analyse_params", "calc", "is_paper_design", "paper_conditions"]
 
 
 def _mm(shim_mm: float) -> str:
@@ -52,13 +55,23 @@ def _paper(key: str, applies: bool) -> float | None:
     return PAPER[key] if applies else None
 
 
+def paper_conditions(params: Params) -> tuple[bool, bool]:
+    """Whether the paper's drop figures (a 90 K drop) and its warm figures (its shim) stand beside
+    this design's: only on the paper's own unit (:func:`is_paper_design`), at those conditions."""
+    if not is_paper_design(params):
+        return False, False
+    drop = params.operating.warm_C - params.operating.cold_C
+    return (math.isclose(drop, PAPER_TEMPERATURE_DROP_K, abs_tol=1e-9),
+            math.isclose(params.shim.thickness_mm, PAPER_SHIM_MM, abs_tol=1e-9))
+
+
 def calc(params: Params) -> list[Figure]:
     r = analyse_params(params)
     op = params.operating
     geom, mesh, ap, cold, design = r.geometry, r.mesh, r.approach, r.cold, r.design
     um = analysis.UM_PER_MM
-    at_paper_dT = math.isclose(ap.temperature_drop_K, PAPER_TEMPERATURE_DROP_K, abs_tol=1e-9)
-    at_paper_shim = math.isclose(design.shim_mm, PAPER_SHIM_MM, abs_tol=1e-9)
+    at_paper_dT, at_paper_shim = paper_conditions(params)
+    paper_unit = is_paper_design(params)
     printed_eq9 = "eq (9) as printed (2tanα also on the t-term)"
 
     figs = [
@@ -159,7 +172,7 @@ def calc(params: Params) -> list[Figure]:
         # Designed backlash: tooth thinning (eq 10) + shim (eq 11), then cooled.
         Figure("unshimmed_warm_backlash_total_min_arcmin", "unshimmed warm total, least (thinning)",
                r.unshimmed_warm_total_min_arcmin, "arcmin", digits=2,
-               note="reconstructed thinning, docs"),
+               note="reconstructed thinning, docs" if paper_unit else "the design's [backlash] thinning"),
         Figure("unshimmed_warm_backlash_total_max_arcmin", "unshimmed warm total, largest",
                r.unshimmed_warm_total_max_arcmin, "arcmin", digits=2),
         Figure("warm_backlash_total_min_arcmin", f"warm total at {op.warm_C:g} °C, least", warm_min, "arcmin", digits=2,
@@ -168,8 +181,9 @@ def calc(params: Params) -> list[Figure]:
                digits=2, paper=_paper("warm_backlash_total_max_arcmin", at_paper_shim)),
         Figure("cold_backlash_total_min_arcmin", f"cold total at {op.cold_C:g} °C, least",
                design.cold_total_min_arcmin, "arcmin", digits=2,
-               paper=_paper("cold_backlash_total_min_arcmin",
-                            at_paper_shim and at_paper_dT), note="paper: a bound, ≥ 10′"),
+               paper=_paper("cold_backlash_total_min_arcmin", at_paper_shim and at_paper_dT),
+               note=(f"paper: a bound, ≥ {PAPER['cold_backlash_total_min_arcmin']:g}′" if at_paper_shim and at_paper_dT
+                     else "")),
         Figure("cold_backlash_total_max_arcmin", f"cold total at {op.cold_C:g} °C, largest",
                design.cold_total_max_arcmin, "arcmin", digits=2),
         Figure("cold_backlash_per_side_min_arcmin", f"cold per side at {op.cold_C:g} °C, least",
@@ -230,20 +244,25 @@ def _exact_total(exact: RangeCheck | None, name: str) -> str:
 
 
 def _thinning_figures(params: Params) -> list[Figure]:
+    """The thinning the gears are built with: the design's [backlash] (an input), or, calibrated, the
+    one solved from the measured backlash beside the [backlash] set through the paper's model."""
     th = params.thinning()
     um = analysis.UM_PER_MM
-    source = "solved on the exact geometry from the measured backlash" if th.calibrated else "template [backlash]"
+    source = "solved on the exact geometry from the measured backlash" if th.calibrated else "the design's [backlash]"
     figs = [
-        Figure("paper_model_thinning_min_um", "tooth thinning per mesh, least: paper-model reconstruction",
-               th.template_min_mm * um, "µm", digits=1, note="[backlash], through eqs (10), (11)"),
-        Figure("paper_model_thinning_max_um", "tooth thinning per mesh, largest: paper-model reconstruction",
-               th.template_max_mm * um, "µm", digits=1),
         Figure("design_thinning_min_um", "tooth thinning per mesh, least: the gears built", th.min_mm * um, "µm",
                digits=2, note=source),
         Figure("design_thinning_max_um", "tooth thinning per mesh, largest: the gears built", th.max_mm * um, "µm",
                digits=2),
     ]
     if th.calibrated:
+        figs[:0] = [
+            Figure("paper_model_thinning_min_um",
+                   "tooth thinning per mesh, least: [backlash] through the paper's model", th.template_min_mm * um,
+                   "µm", digits=1, note="eqs (10), (11); replaced by the calibration"),
+            Figure("paper_model_thinning_max_um", "tooth thinning per mesh, largest: [backlash]",
+                   th.template_max_mm * um, "µm", digits=1),
+        ]
         c = params.calibration
         where = f"shim {_mm(float(c.measured_shim_mm or 0.0))} mm, {c.measured_at_C:g} °C"
         figs += [

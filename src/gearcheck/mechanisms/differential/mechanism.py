@@ -7,14 +7,16 @@ and the report (:mod:`.verdicts`, :mod:`.report`)."""
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, ClassVar
 
+from gearcheck.drafting import NewInput
 from gearcheck.mechanism import Assembly, Mechanism, SweepPlan
 from gearcheck.mechanisms.differential import MESH_TOL_MM, calc
 from gearcheck.mechanisms.differential.params import Params as DifferentialParams
 
 if TYPE_CHECKING:
     from gearcheck.cad.placement import Part
+    from gearcheck.drafting import Draft
     from gearcheck.figures import Figure
     from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body
@@ -31,6 +33,10 @@ class Differential(Mechanism):
     mesh_tol_mm = MESH_TOL_MM
     template = "zhurong_differential.toml"
     nan_figures = frozenset()
+    new_inputs: ClassVar[tuple[NewInput, ...]] = (
+        NewInput("module", "outer (transverse) module, mm, e.g. 3"),
+        NewInput("teeth", "small/big tooth counts, e.g. 14/30"),
+    )
 
     def analyse(self, params: DifferentialParams) -> list[Figure]:
         return calc(params)
@@ -90,6 +96,13 @@ class Differential(Mechanism):
         from gearcheck.mechanisms.differential.report import report
 
         return report(params, outcome, verdicts)
+
+    def new(self, inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
+        """A design from ``--module`` and ``--teeth SMALL/BIG``, every other value derived
+        (:mod:`.derive`: cone geometry, the common apex, Gleason's shift, the standard backlash)."""
+        from gearcheck.mechanisms.differential.derive import new
+
+        return new(inputs, overrides)
 
     def sample(self, data: dict, draw: Any) -> None:
         from gearcheck.mechanisms.differential.sampling import sample_differential

@@ -18,6 +18,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from gearcheck.mechanisms.differential import analysis, poses  # numpy only
 from gearcheck.mechanisms.differential import calibration as cal  # numpy only
+from gearcheck.params.problems import Problems
 from gearcheck.params.common import MISSING, ParamError, Section, bisect_boundary, fmt_bound, fmt_range
 
 # The mounting dimensions a, b must put the pitch circles on the common apex (b/2 = l11 + l12 +
@@ -27,6 +28,16 @@ APEX_TOLERANCE_MM = 0.05
 MAX_STUDY_SHIMS = 12
 MATERIAL_NAME_MAX = 40
 SHIFT_MIN, SHIFT_MAX = -1.0, 1.5  # the small gear's profile shift coefficient (field range)
+
+
+def apex_b_mm(geom: analysis.ConeGeometry, l11_mm: float, l12_mm: float) -> float:
+    """b that puts the big gears' pitch circles on the common apex: b/2 = l11 + l12 + d2/2."""
+    return 2.0 * (l11_mm + l12_mm + geom.small_pitch_diameter_mm / 2.0)
+
+
+def apex_a_mm(geom: analysis.ConeGeometry, l2_mm: float) -> float:
+    """a that puts the small gears' pitch circles on the common apex: a/2 = l2 + d1/2."""
+    return 2.0 * (l2_mm + geom.big_pitch_diameter_mm / 2.0)
 
 
 def _unit(unit: str) -> dict:
@@ -55,25 +66,34 @@ class Gears(Section):
 
     @model_validator(mode="after")
     def _rules(self) -> Gears:
-        if self.shaft_angle_deg != 90.0:
-            raise ParamError("gears.shaft_angle_deg", self.shaft_angle_deg,
-                             "allowed 90 deg only: eqs (1), (6), (7) assume perpendicular big and small gear axes")
-        if self.small_teeth > self.big_teeth:
-            raise ParamError("gears.small_teeth", self.small_teeth,
-                             f"allowed <= big_teeth = {self.big_teeth}: the shimmed big gears are the output gears")
-        geom = analysis.cone_geometry(self.module_mm, self.big_teeth, self.small_teeth)
-        max_face = analysis.MAX_FACE_WIDTH_FRACTION * geom.outer_cone_distance_mm
-        if self.face_width_mm > max_face:
-            raise ParamError("gears.face_width_mm", self.face_width_mm,
-                             f"allowed <= {fmt_bound(max_face, 'upper', 2)} mm: one third of the outer cone distance "
-                             f"Re = {geom.outer_cone_distance_mm:.2f} mm (teeth too thin at the inner end)")
+        with Problems() as p:  # independent rules: every one broken is named
+            if self.shaft_angle_deg != 90.0:
+                p.add("gears.shaft_angle_deg", self.shaft_angle_deg,
+                      "allowed 90 deg only: eqs (1), (6), (7) assume perpendicular big and small gear axes")
+            if self.small_teeth > self.big_teeth:
+                p.add("gears.small_teeth", self.small_teeth,
+                      f"allowed <= big_teeth = {self.big_teeth}: the shimmed big gears are the output gears")
+            geom = analysis.cone_geometry(self.module_mm, self.big_teeth, self.small_teeth)
+            max_face = analysis.MAX_FACE_WIDTH_FRACTION * geom.outer_cone_distance_mm
+            if self.face_width_mm > max_face:
+                p.add("gears.face_width_mm", self.face_width_mm,
+                      f"allowed <= {fmt_bound(max_face, 'upper', 2)} mm: one third of the outer cone distance "
+                      f"Re = {geom.outer_cone_distance_mm:.2f} mm (teeth too thin at the inner end)")
+            shift = self._shift_problem(geom)
+            if shift is not None:
+                p.extend(shift)
+        return self
+
+    def _shift_problem(self, geom: analysis.ConeGeometry) -> ParamError | None:
+        """The profile shift's first broken rule (undercut, interference, pointed tips, contact
+        ratio) with the range that satisfies all of them, or None."""
         alpha = math.radians(self.pressure_angle_deg)
         mesh = analysis.virtual_mesh(geom, alpha, self.small_profile_shift)
         x = self.small_profile_shift
         min_tip = analysis.MIN_TIP_THICKNESS_MODULES * self.module_mm
         failed = [name for name, ok in _shift_rules(geom, alpha, min_tip).items() if not ok(x)]
         if not failed:
-            return self
+            return None
         shift_range = _shift_range(geom, alpha, min_tip, f"{self.small_teeth}/{self.big_teeth} teeth and "
                                                          f"{self.pressure_angle_deg:g}°")
         why = {
@@ -88,13 +108,14 @@ class Gears(Section):
             "contact ratio": f"contact ratio of the back-cone virtual pair is {mesh.contact_ratio:.3f} < "
                              f"{analysis.MIN_CONTACT_RATIO}: a tooth pair lets go before the next engages",
         }[failed[0]]
-        raise ParamError("gears.small_profile_shift", x,
-                         f"{shift_range}: {why}; Gleason's rule gives {mesh.gleason_small_shift:.2f}")
-        return self
+        return ParamError("gears.small_profile_shift", x,
+                          f"{shift_range}: {why}; Gleason's rule gives {mesh.gleason_small_shift:.2f}")
 
 
 class Backlash(Section):
-    """Designed backlash at the common apex before shimming (a reconstruction: the paper lost it)."""
+    """The designed backlash before shimming, an input: the tooth thinning of one mesh (the gears are
+    built with the least). `gearcheck new` derives it from the standard backlash for the module and
+    cone distance; the shipped template's is a reconstruction (the paper lost it)."""
 
     mesh_thinning_min_mm: float = Field(
         ge=0.0, le=0.5,
@@ -165,14 +186,15 @@ class Operating(Section):
 
     @model_validator(mode="after")
     def _order(self) -> Operating:
-        if self.cold_C > self.warm_C:
-            raise ParamError("operating.cold_C", self.cold_C, f"allowed <= warm_C = {self.warm_C} °C")
-        if self.operating_min_C > self.operating_max_C:
-            raise ParamError("operating.operating_min_C", self.operating_min_C,
-                             f"allowed <= operating_max_C = {self.operating_max_C} °C")
-        if self.storage_min_C > self.storage_max_C:
-            raise ParamError("operating.storage_min_C", self.storage_min_C,
-                             f"allowed <= storage_max_C = {self.storage_max_C} °C")
+        with Problems() as p:
+            if self.cold_C > self.warm_C:
+                p.add("operating.cold_C", self.cold_C, f"allowed <= warm_C = {self.warm_C} °C")
+            if self.operating_min_C > self.operating_max_C:
+                p.add("operating.operating_min_C", self.operating_min_C,
+                      f"allowed <= operating_max_C = {self.operating_max_C} °C")
+            if self.storage_min_C > self.storage_max_C:
+                p.add("operating.storage_min_C", self.storage_min_C,
+                      f"allowed <= storage_max_C = {self.storage_max_C} °C")
         return self
 
 
@@ -196,14 +218,16 @@ class Shim(Section):
     @model_validator(mode="after")
     def _study(self) -> Shim:
         seen: dict[str, float] = {}
-        for i, s in enumerate(self.study_mm):
-            if not (0.0 <= s <= 1.0) or not math.isfinite(s):
-                raise ParamError(f"shim.study_mm.{i}", s, "out of range: allowed 0 to 1.0 mm")
-            key = shim_key(s)
-            if key in seen:
-                raise ParamError(f"shim.study_mm.{i}", s,
-                                 f"allowed distinct values at 0.001 mm resolution (same as {seen[key]})")
-            seen[key] = s
+        with Problems() as p:
+            for i, s in enumerate(self.study_mm):
+                if not (0.0 <= s <= 1.0) or not math.isfinite(s):
+                    p.add(f"shim.study_mm.{i}", s, "out of range: allowed 0 to 1.0 mm")
+                    continue
+                key = shim_key(s)
+                if key in seen:
+                    p.add(f"shim.study_mm.{i}", s,
+                          f"allowed distinct values at 0.001 mm resolution (same as {seen[key]})")
+                seen[key] = s
         return self
 
 
@@ -213,10 +237,11 @@ MEASURED_TOTAL_MAX_ARCMIN = 120.0  # both sides; 60′ per side, well within the
 
 
 class Calibration(Section):
-    """Backlash measured on a built unit (optional; all four keys or none). When given, the tooth
-    thinning the gears are built with is solved on the exact geometry so that it reproduces the
-    measurement (the least measured total → the least thinning, read as the cycle minimum); the
-    [backlash] thinning stays as the paper-model reconstruction (docs/differential.md)."""
+    """Backlash measured on a built unit (optional; all four keys or none): a measurement of the unit
+    this template describes, not a design input. When given, the tooth thinning the gears are built
+    with is solved on the exact geometry so that it reproduces the measurement (the least measured
+    total → the least thinning, read as the cycle minimum); [backlash] stays as the thinning set
+    through the paper's first-order model (docs/differential.md)."""
 
     measured_backlash_total_min_arcmin: float | None = Field(
         default=None, gt=0.0, le=MEASURED_TOTAL_MAX_ARCMIN,
@@ -235,14 +260,15 @@ class Calibration(Section):
     @model_validator(mode="after")
     def _all_or_none(self) -> Calibration:
         given = [k for k in CALIBRATION_KEYS if getattr(self, k) is not None]
-        if given and len(given) < len(CALIBRATION_KEYS):
-            missing = next(k for k in CALIBRATION_KEYS if getattr(self, k) is None)
-            raise ParamError(f"calibration.{missing}", MISSING,
-                             f"allowed: a value — [calibration] needs all of {', '.join(CALIBRATION_KEYS)} or none")
-        lo, hi = self.measured_backlash_total_min_arcmin, self.measured_backlash_total_max_arcmin
-        if lo is not None and hi is not None and hi < lo:
-            raise ParamError("calibration.measured_backlash_total_max_arcmin", hi,
-                             f"allowed >= measured_backlash_total_min_arcmin = {lo}′")
+        with Problems() as p:
+            if given and len(given) < len(CALIBRATION_KEYS):
+                for missing in (k for k in CALIBRATION_KEYS if getattr(self, k) is None):
+                    p.add(f"calibration.{missing}", MISSING,
+                          f"allowed: a value — [calibration] needs all of {', '.join(CALIBRATION_KEYS)} or none")
+            lo, hi = self.measured_backlash_total_min_arcmin, self.measured_backlash_total_max_arcmin
+            if lo is not None and hi is not None and hi < lo:
+                p.add("calibration.measured_backlash_total_max_arcmin", hi,
+                      f"allowed >= measured_backlash_total_min_arcmin = {lo}′")
         return self
 
     @property
@@ -290,25 +316,26 @@ class Params(Section):
     def _assembly(self) -> Params:
         geom = analysis.cone_geometry(self.gears.module_mm, self.gears.big_teeth, self.gears.small_teeth)
         d = self.dimensions
-        b_apex = 2.0 * (d.l11_mm + d.l12_mm + geom.small_pitch_diameter_mm / 2.0)
-        b_lo, b_hi = b_apex - APEX_TOLERANCE_MM, b_apex + APEX_TOLERANCE_MM
-        if not b_lo <= d.b_mm <= b_hi:
-            raise ParamError("dimensions.b_mm", d.b_mm,
-                             f"allowed {fmt_range(b_lo, b_hi)} mm ({b_apex:.3f} ± {APEX_TOLERANCE_MM}): the big pitch "
-                             "circles must meet the common apex, b/2 = l11 + l12 + d2/2 (change l11_mm or l12_mm "
-                             "with it)")
-        a_apex = 2.0 * (d.l2_mm + geom.big_pitch_diameter_mm / 2.0)
-        a_lo, a_hi = a_apex - APEX_TOLERANCE_MM, a_apex + APEX_TOLERANCE_MM
-        if not a_lo <= d.a_mm <= a_hi:
-            raise ParamError("dimensions.a_mm", d.a_mm,
-                             f"allowed {fmt_range(a_lo, a_hi)} mm ({a_apex:.3f} ± {APEX_TOLERANCE_MM}): the small "
-                             "pitch circles must meet the common apex, a/2 = l2 + d1/2 (change l2_mm with it)")
-        gain = analysis.shim_gain(geom, math.radians(self.gears.pressure_angle_deg), self.shim.thickness_mm)
-        warm_min_per_side = analysis.big_gear_arcmin(self.backlash.mesh_thinning_min_mm, geom) + gain.per_side_arcmin
-        if warm_min_per_side <= 0.0:
-            raise ParamError("backlash.mesh_thinning_min_mm", self.backlash.mesh_thinning_min_mm,
-                             f"allowed > 0 mm with shim.thickness_mm = {self.shim.thickness_mm}: the warm backlash "
-                             f"would be {warm_min_per_side:.2f}′ per side (the mesh binds at room temperature)")
+        with Problems() as p:  # independent rules: every one broken is named; the CAD's need them to hold
+            b_apex = apex_b_mm(geom, d.l11_mm, d.l12_mm)
+            b_lo, b_hi = b_apex - APEX_TOLERANCE_MM, b_apex + APEX_TOLERANCE_MM
+            if not b_lo <= d.b_mm <= b_hi:
+                p.add("dimensions.b_mm", d.b_mm,
+                      f"allowed {fmt_range(b_lo, b_hi)} mm ({b_apex:.3f} ± {APEX_TOLERANCE_MM}): the big pitch "
+                      "circles must meet the common apex, b/2 = l11 + l12 + d2/2 (or change l11_mm or l12_mm with it)")
+            a_apex = apex_a_mm(geom, d.l2_mm)
+            a_lo, a_hi = a_apex - APEX_TOLERANCE_MM, a_apex + APEX_TOLERANCE_MM
+            if not a_lo <= d.a_mm <= a_hi:
+                p.add("dimensions.a_mm", d.a_mm,
+                      f"allowed {fmt_range(a_lo, a_hi)} mm ({a_apex:.3f} ± {APEX_TOLERANCE_MM}): the small "
+                      "pitch circles must meet the common apex, a/2 = l2 + d1/2 (or change l2_mm with it)")
+            gain = analysis.shim_gain(geom, math.radians(self.gears.pressure_angle_deg), self.shim.thickness_mm)
+            warm_min_per_side = (analysis.big_gear_arcmin(self.backlash.mesh_thinning_min_mm, geom)
+                                 + gain.per_side_arcmin)
+            if warm_min_per_side <= 0.0:
+                p.add("backlash.mesh_thinning_min_mm", self.backlash.mesh_thinning_min_mm,
+                      f"allowed > 0 mm with shim.thickness_mm = {self.shim.thickness_mm}: the warm backlash "
+                      f"would be {warm_min_per_side:.2f}′ per side (the mesh binds at room temperature)")
         why = _cad_blocker(self)
         if why is not None:
             raise _blame(self, why)
@@ -383,6 +410,30 @@ def _shift_rules(geom, alpha: float, min_tip: float) -> dict:
     }
 
 
+def shift_bounds(geom, alpha: float, min_tip: float) -> tuple[float, float] | None:
+    """The small gear's allowed profile shifts under all of :func:`_shift_rules`, unrounded, inside
+    the field's own range; None when no shift satisfies them."""
+    rules = _shift_rules(geom, alpha, min_tip)
+    x_hi: float | None = analysis.max_small_shift_for_tip(geom, alpha)
+    x_lo: float | None = max(analysis.virtual_mesh(geom, alpha, 0.0).small_undercut_min_shift,
+                             analysis.min_small_shift_for_interference(geom, alpha))
+    if x_lo is not None and x_hi is not None and not rules["big tip"](x_lo):
+        # the big gear's tip thins as x falls: its least shift, found from the small gear's limit down
+        x_lo = _boundary(rules["big tip"], x_hi, x_lo)
+    if x_lo is not None and x_hi is not None and not rules["contact ratio"](x_hi):
+        # the contact ratio falls as x grows past its peak: the largest shift that keeps it
+        x_hi = _boundary(rules["contact ratio"], x_lo, x_hi)
+    if x_lo is None or x_hi is None:
+        return None
+    x_lo, x_hi = max(x_lo, SHIFT_MIN), min(x_hi, SHIFT_MAX)  # inside the field's own range
+    return (x_lo, x_hi) if x_lo <= x_hi else None
+
+
+def shift_ok(geom, alpha: float, min_tip: float, x: float) -> bool:
+    """Whether the small gear's profile shift ``x`` passes every rule of :func:`_shift_rules`."""
+    return all(ok(x) for ok in _shift_rules(geom, alpha, min_tip).values())
+
+
 def _shift_range(geom, alpha: float, min_tip: float, where: str) -> str:
     """'allowed lo to hi' for the small gear's profile shift under all of :func:`_shift_rules`
     (each end rounded inward and checked against those rules), or why no shift works."""
@@ -394,21 +445,11 @@ def _shift_range(geom, alpha: float, min_tip: float, where: str) -> str:
     def high_ok(v: float) -> bool:
         return rules["small tip"](v) and rules["contact ratio"](v)
 
-    x_hi: float | None = analysis.max_small_shift_for_tip(geom, alpha)
-    x_lo: float | None = max(analysis.virtual_mesh(geom, alpha, 0.0).small_undercut_min_shift,
-                             analysis.min_small_shift_for_interference(geom, alpha))
-    if x_lo is not None and x_hi is not None and not rules["big tip"](x_lo):
-        # the big gear's tip thins as x falls: its least shift, found from the small gear's limit down
-        x_lo = _boundary(rules["big tip"], x_hi, x_lo)
-    if x_lo is not None and x_hi is not None and not rules["contact ratio"](x_hi):
-        # the contact ratio falls as x grows past its peak: the largest shift that keeps it
-        x_hi = _boundary(rules["contact ratio"], x_lo, x_hi)
-    if x_lo is not None and x_hi is not None:  # inside the field's own range
-        x_lo, x_hi = max(x_lo, SHIFT_MIN), min(x_hi, SHIFT_MAX)
-    if x_lo is None or x_hi is None or x_lo > x_hi:
+    bounds = shift_bounds(geom, alpha, min_tip)
+    if bounds is None:
         return (f"no shift allowed at {where} (no undercut, tip interference or pointed big gear needs x above the "
                 "shifts that keep the small gear's tip land and a contact ratio >= 1)")
-    return f"allowed {fmt_range(x_lo, x_hi, lo_ok=low_ok, hi_ok=high_ok)}"
+    return f"allowed {fmt_range(*bounds, lo_ok=low_ok, hi_ok=high_ok)}"
 
 
 def _blame(params: Params, why: str) -> ParamError:

@@ -10,8 +10,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from gearcheck.mechanisms.differential import PAPER, PAPER_SHIM_MM, PAPER_TEMPERATURE_DROP_K
-from gearcheck.mechanisms.differential.analysis import analyse_params
+from gearcheck.mechanisms.differential import PAPER, paper_conditions
 from gearcheck.mechanisms.differential.reduce import SweepData
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS
 from gearcheck.mechanisms.differential.temperature import STATE_TEXT, RangeCheck, shim_text
@@ -153,9 +152,7 @@ def comparisons(params, data: SweepData, summary: dict) -> list[Comparison]:
 def _comparisons(params, data: SweepData, summary: dict) -> list[Comparison]:
     t, z, w, c, shims, model, models = data.t, data.z, data.w, data.c, data.shims, data.model, data.models
     geom_min, exact_min = data.geom_min, data.exact_min
-    r = analyse_params(params)
-    at_paper_dT = math.isclose(r.approach.temperature_drop_K, PAPER_TEMPERATURE_DROP_K, abs_tol=1e-9)
-    at_paper_shim = math.isclose(data.template_shim_mm, PAPER_SHIM_MM, abs_tol=1e-9)
+    at_paper_dT, at_paper_shim = paper_conditions(params)  # the paper's unit, at the paper's conditions
     thinning = params.thinning()
     why = ("displaced apexes make the mesh non-conjugate (docs/differential.md); a net approach is decided at the toe, "
            "an opening at the heel: reported, not tuned")
@@ -264,14 +261,14 @@ def _temperature_note(params, data: SweepData) -> str:
 def _thinning_note(params, data: SweepData) -> str:
     th = params.thinning()
     if not th.calibrated:
-        return (f"Tooth thinning {th.min_mm:.4f}–{th.max_mm:.4f} mm per mesh: the template's reconstruction through "
-                "the paper's first-order model (no measured backlash given to calibrate it on the exact geometry).")
+        return (f"Tooth thinning {th.min_mm:.4f}–{th.max_mm:.4f} mm per mesh: the design's [backlash], built with the "
+                "least (no measured backlash given to calibrate it on the exact geometry).")
     c = params.calibration
     measured = f"{c.measured_backlash_total_min_arcmin:g}–{c.measured_backlash_total_max_arcmin:g}′"
     return (f"Calibration: the measured {measured} (both sides, shim {c.measured_shim_mm:g} mm, "
             f"{c.measured_at_C:g} °C, read as the least over the cycle) needs {th.min_mm:.4f}–{th.max_mm:.4f} mm of "
-            "tooth thinning per mesh on the exact geometry; the paper-model "
-            f"reconstruction {th.template_min_mm:.4f}–{th.template_max_mm:.4f} mm gives only "
+            "tooth thinning per mesh on the exact geometry; the template's [backlash] "
+            f"{th.template_min_mm:.4f}–{th.template_max_mm:.4f} mm gives only "
             f"{th.template_exact_total_min_arcmin:.2f}′ (least) on the exact geometry. The gears are built with the "
             "solved thinning; the warm figures therefore match the measurement by construction, and the cold and "
             "storage figures follow from it.")
@@ -363,6 +360,6 @@ def notes(params, data: SweepData, summary: dict) -> list[str]:
     if binding:
         where = ", ".join(f"{shim_text(shims[i])} mm" for i in binding)
         out.append(f"Binds cold (geometry) at shim {where}: least cold "
-                   f"play {', '.join(f'{geom_min[i, c]:.2f}′' for i in binding)} per side; the paper shims for this "
-                   "reason.")
+                   f"play {', '.join(f'{geom_min[i, c]:.2f}′' for i in binding)} per side; a shim opens the mesh "
+                   "(eq 11).")
     return out

@@ -14,6 +14,10 @@ FACE_WIDTH_MM = 30.0
 # Pinion bore (not in the paper; the pinion sits on the steering collar). It must stay inside
 # the root circle (79 mm), where nothing meets the rack.
 PINION_BORE_DIAMETER_MM = 60.0
+# Rack body under its teeth, in modules: the rack's root line lies this far above its datum
+# (mounting face). The paper's rack, root 18 mm above the datum at m = 4, scaled with the module;
+# `gearcheck new` sets the centre height H from it (H = r + x·m + (rack dedendum + this)·m).
+RACK_ROOT_MODULES = 4.5
 # Materials (not in the paper; aircraft steering gears are through-hardened alloy steel).
 PINION_MATERIAL = "steel"
 RACK_MATERIAL = "steel"

@@ -14,10 +14,12 @@ from gearcheck.mechanisms.steering import sampling as _sampling
 from gearcheck.mechanisms.steering import sweep as _sweep
 from gearcheck.mechanisms.steering import verdicts as _verdicts
 from gearcheck.mechanisms.steering.params import Params as SteeringParams
+from gearcheck.drafting import NewInput
 
 if TYPE_CHECKING:
     from gearcheck.cad.placement import Part
     from gearcheck.figures import Figure
+    from gearcheck.drafting import Draft
     from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body
 
@@ -35,6 +37,10 @@ class Steering(Mechanism):
     template: ClassVar[str | None] = "nose_wheel_steering.toml"
     fuzz_seed_base: ClassVar[int] = 2_000_000
     nan_figures: ClassVar[frozenset[str]] = _sampling.NAN_FIGURES
+    new_inputs: ClassVar[tuple[NewInput, ...]] = (
+        NewInput("module", "module m in mm, e.g. --module 5"),
+        NewInput("teeth", "pinion teeth z (the full pinion the sector is cut from), e.g. --teeth 34"),
+    )
 
     def smallest_clearance(self, params: SteeringParams) -> Clearance | None:
         """None: the steering check decides no non-zero clearance. Its flanks mesh at zero backlash
@@ -69,6 +75,12 @@ class Steering(Mechanism):
 
     def report(self, params: SteeringParams, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
         return _report.report(params, outcome, verdicts)
+
+    def new(self, inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
+        """The paper's design chain from the module and tooth count (:mod:`.derive`)."""
+        from gearcheck.mechanisms.steering.derive import new
+
+        return new(inputs, overrides)
 
     def sample(self, data: dict, draw: Any) -> None:
         _sampling.sample(data, draw)

@@ -3,7 +3,9 @@
 Only inputs: the pinion and rack basic profiles, the sector and rack tooth indices, the centre
 height H, the machined trims (hS2…hS8, RS1), the contact-ratio design rule and the two angle
 requirements. Everything the paper derives (r, Ra, h, p, s, L, hS4 from ε, …) is computed.
-Cross-field rules raise :class:`ParamError` naming one field, its value and the allowed range.
+Cross-field rules raise :class:`ParamError` naming the field, its value and the allowed range, one
+line for each independent rule broken (:class:`~gearcheck.params.common.Problems`; rules that need
+earlier ones to hold come after them).
 They include what the CAD needs (no pointed tooth or cutter tip, a rack root space, the pinion
 bore inside the root circle: the same RackPinionGeometry properties and layout constants the CAD
 builds from), so a set the CAD could not build is rejected before any CAD work. Whether the pinion's
@@ -20,6 +22,7 @@ from pydantic import Field, model_validator
 
 from gearcheck.mechanisms.steering import analysis, layout
 from gearcheck.params import ParamError, Section
+from gearcheck.params.problems import Problems
 from gearcheck.params.common import bisect_boundary, fmt_bound, fmt_range
 
 MM: dict[str, Any] = {"unit": "mm"}
@@ -105,18 +108,20 @@ class Params(Section):
 
 
 def _check_indexing(p: Params) -> None:
-    """Tooth indexing: G1 sits left of the first rack tooth and drives it (paper fig. 5)."""
+    """Tooth indexing: G1 sits left of the first rack tooth and drives it (paper fig. 5). The three
+    pairings are independent (each broken one is named); the sector's size needs them to hold."""
     pin, rack, z = p.pinion, p.rack, p.pinion.teeth
-    if rack.last_tooth != -rack.first_tooth:
-        raise ParamError("rack.last_tooth", rack.last_tooth,
-                         f"must mirror rack.first_tooth: allowed {-rack.first_tooth} (the trims repeat at both ends)")
-    if pin.sector_first_tooth != rack.first_tooth - 1:
-        raise ParamError("pinion.sector_first_tooth", pin.sector_first_tooth,
-                         f"allowed {rack.first_tooth - 1} = rack.first_tooth - 1 "
-                         "(the topped tooth G1 drives the first rack tooth)")
-    if pin.sector_last_tooth != rack.last_tooth:
-        raise ParamError("pinion.sector_last_tooth", pin.sector_last_tooth,
-                         f"allowed {rack.last_tooth} = rack.last_tooth (mirror of G1)")
+    with Problems() as found:
+        if rack.last_tooth != -rack.first_tooth:
+            found.add("rack.last_tooth", rack.last_tooth,
+                      f"must mirror rack.first_tooth: allowed {-rack.first_tooth} (the trims repeat at both ends)")
+        if pin.sector_first_tooth != rack.first_tooth - 1:
+            found.add("pinion.sector_first_tooth", pin.sector_first_tooth,
+                      f"allowed {rack.first_tooth - 1} = rack.first_tooth - 1 "
+                      "(the topped tooth G1 drives the first rack tooth)")
+        if pin.sector_last_tooth != rack.last_tooth:
+            found.add("pinion.sector_last_tooth", pin.sector_last_tooth,
+                      f"allowed {rack.last_tooth} = rack.last_tooth (mirror of G1)")
     sector = pin.sector_last_tooth - pin.sector_first_tooth + 1
     if sector > z:
         raise ParamError("pinion.teeth", z, f"allowed >= {sector} (the {sector}-tooth sector is part of the pinion)")
@@ -132,29 +137,32 @@ def _check(p: Params) -> None:
     tip = r + (pin.addendum_coefficient + x) * m
     H = p.layout.centre_to_datum_mm
 
-    # Basic profiles: clearances, no undercut, no pointed teeth.
+    # Basic profiles: clearances, no undercut, no pointed teeth, the rack root above its datum:
+    # independent rules, every one broken is named.
     # (The shift moves the rack's reference line with the pinion, so it cancels in both.)
+    found = Problems()
     if rack.dedendum_coefficient <= pin.addendum_coefficient:
-        raise ParamError("rack.dedendum_coefficient", rack.dedendum_coefficient,
-                         f"allowed > {fmt_bound(pin.addendum_coefficient, 'lower', None)} "
-                         "(pinion addendum: the pinion tip must clear the rack root)")
+        found.add("rack.dedendum_coefficient", rack.dedendum_coefficient,
+                  f"allowed > {fmt_bound(pin.addendum_coefficient, 'lower', None)} "
+                  "(pinion addendum: the pinion tip must clear the rack root)")
     if pin.dedendum_coefficient <= rack.addendum_coefficient:
-        raise ParamError("pinion.dedendum_coefficient", pin.dedendum_coefficient,
-                         f"allowed > {fmt_bound(rack.addendum_coefficient, 'lower', None)} "
-                         "(rack addendum: the rack tip must clear the pinion root)")
+        found.add("pinion.dedendum_coefficient", pin.dedendum_coefficient,
+                  f"allowed > {fmt_bound(rack.addendum_coefficient, 'lower', None)} "
+                  "(rack addendum: the rack tip must clear the pinion root)")
     depth = (pin.dedendum_coefficient - x) * m
     if depth > r * math.sin(a) ** 2:
-        raise _undercut_error(p, depth, a)
+        found.extend(_undercut_error(p, depth, a))
+    found.check()  # the tooth forms below are drawn from these profiles
     g = analysis.geometry_from_params(p)
-    _check_tooth_forms(g)
+    _check_tooth_forms(g, found)
     rack_root = H - r - x * m - rack.dedendum_coefficient * m
     if rack_root <= 0:
         def root_above(v: float) -> bool:
             return v - r - x * m - rack.dedendum_coefficient * m > 0
 
         h_min = fmt_bound(r + x * m + rack.dedendum_coefficient * m, "lower", ok=root_above, strict=True)
-        raise ParamError("layout.centre_to_datum_mm", H,
-                         f"allowed > {h_min} mm (the rack root must lie above its datum)")
+        found.add("layout.centre_to_datum_mm", H, f"allowed > {h_min} mm (the rack root must lie above its datum)")
+    found.check()
 
     # Trims: between the rolling line and the rack tooth top; hS4 must keep the contact ratio >= 1.
     h = H - r
@@ -177,17 +185,20 @@ def _check(p: Params) -> None:
                          f"({top:.3f} mm) must lie above the rolling line ({h:.3f} mm), where the trims hS2–hS8 lie")
     rs1 = pin.topped_radius_mm
     rs1_lo = max(H - trim.hS2_mm, _form_radius(r, rb, a, depth))
-    _check_trim_ranges(g, h, top, max(h, h_for_ratio(1.0)))
+    # the four trims and the contact-ratio rule are independent: every one broken is named
+    _check_trim_ranges(g, h, top, max(h, h_for_ratio(1.0)), found)
     if trim.min_contact_ratio > eps_top:
-        raise ParamError("trim.min_contact_ratio", trim.min_contact_ratio,
-                         f"allowed 1 to {fmt_bound(eps_top, 'upper')} (the untrimmed rack's contact ratio)")
+        found.add("trim.min_contact_ratio", trim.min_contact_ratio,
+                  f"allowed 1 to {fmt_bound(eps_top, 'upper')} (the untrimmed rack's contact ratio)")
+    hs2_ok = not any(e.field == "trim.hS2_mm" for e in found.errors)
 
     # RS1: G1's tip circle must reach down to S2 (it is the last corner that drags the rack),
-    # and topping only removes material.
-    if not (rs1_lo < rs1 <= tip):
-        raise ParamError("pinion.topped_radius_mm", rs1,
-                         f"allowed {fmt_range(rs1_lo, tip, lo_open=True)} mm "
-                         "(G1's tip circle must reach S2 at height hS2; at most the tip radius)")
+    # and topping only removes material (its lower end needs hS2 in range).
+    if hs2_ok and not (rs1_lo < rs1 <= tip):
+        found.add("pinion.topped_radius_mm", rs1,
+                  f"allowed {fmt_range(rs1_lo, tip, lo_open=True)} mm "
+                  "(G1's tip circle must reach S2 at height hS2; at most the tip radius)")
+    found.check()
 
 
 def _undercut_error(p: Params, depth: float, a: float) -> ParamError:
@@ -226,7 +237,7 @@ def _untrimmed_ratio_error(g, eps_top: float, untrimmed_ratio) -> ParamError:
     return ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient, f"allowed {ha_range}: {why}")
 
 
-def _check_trim_ranges(g, h: float, top: float, hs4_min: float) -> None:
+def _check_trim_ranges(g, h: float, top: float, hs4_min: float, found: Problems) -> None:
     """Each trim height between the rolling line h (hS4: where the contact ratio reaches 1) and
     the rack tooth top: a corner outside that band is no trim of this rack tooth. How high S6 and
     S8 may stand under the tip lands that pass over them depends on where the rack stops, so it is
@@ -237,13 +248,14 @@ def _check_trim_ranges(g, h: float, top: float, hs4_min: float) -> None:
         why = ("contact ratio >= 1 up to the rack tooth top" if name == "hS4_mm"
                else "above the rack pitch line, at most the rack tooth top")
         if not (lo < value <= top):
-            raise ParamError(f"trim.{name}", value, f"allowed {fmt_range(lo, top, lo_open=True)} mm ({why})")
+            found.add(f"trim.{name}", value, f"allowed {fmt_range(lo, top, lo_open=True)} mm ({why})")
 
 
-def _check_tooth_forms(g) -> None:
+def _check_tooth_forms(g, found: Problems) -> None:
     """Teeth the CAD can build: pinion tip land and rack top land >= MIN_TOP_LAND_MODULES·m, a
     root land between the pinion's fillets (the generating cutter's tip is not pointed), a root
-    space between adjacent rack teeth, and the pinion bore inside the root circle."""
+    space between adjacent rack teeth, and the pinion bore inside the root circle: each a rule on its own
+    feature, every one broken added to ``found``."""
     m, x = g.module_mm, g.profile_shift
     tan_a = math.tan(g.pressure_angle_rad)
     land_min = MIN_TOP_LAND_MODULES * m
@@ -260,42 +272,42 @@ def _check_tooth_forms(g) -> None:
             x_max = bisect_boundary(shift_ok, -1.0, x, steps=60)
             bound = (f"allowed <= {fmt_bound(x_max, 'upper', ok=shift_ok)}" if x_max is not None
                      else "no shift allowed down to -1 at this addendum")
-            raise ParamError("pinion.profile_shift", x,
-                             f"{bound}: pointed pinion teeth, tip land "
-                             f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+            found.add("pinion.profile_shift", x,
+                      f"{bound}: pointed pinion teeth, tip land "
+                      f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+        else:
+            def addendum_ok(v: float) -> bool:
+                return pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v)) >= land_min
 
-        def addendum_ok(v: float) -> bool:
-            return pinion_tip_land(analysis.with_inputs(g, pinion_addendum_coefficient=v)) >= land_min
-
-        ha_max = _boundary(addendum_ok, lo, g.pinion_addendum_coefficient)
-        raise ParamError("pinion.addendum_coefficient", g.pinion_addendum_coefficient,
-                         f"allowed <= {fmt_bound(ha_max, 'upper', ok=addendum_ok)} at this shift: pointed pinion "
-                         "teeth, tip land "
-                         f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+            ha_max = _boundary(addendum_ok, lo, g.pinion_addendum_coefficient)
+            found.add("pinion.addendum_coefficient", g.pinion_addendum_coefficient,
+                      f"allowed <= {fmt_bound(ha_max, 'upper', ok=addendum_ok)} at this shift: pointed pinion "
+                      "teeth, tip land "
+                      f"{pinion_tip_land(g):.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
     w0 = g.rack_half_thickness_at_rolling_line
     if g.cutter_tip_half_width <= 0.0:
         def cutter_ok(v: float) -> bool:
             return analysis.with_inputs(g, pinion_dedendum_coefficient=v).cutter_tip_half_width > 0.0
 
         hf_max = fmt_bound(x + w0 / (m * tan_a), "upper", ok=cutter_ok, strict=True)
-        raise ParamError("pinion.dedendum_coefficient", g.pinion_dedendum_coefficient,
-                         f"allowed < {hf_max} at this shift and pressure angle: the generating "
-                         "rack's tip comes to a point, leaving no root land between the pinion's fillets")
+        found.add("pinion.dedendum_coefficient", g.pinion_dedendum_coefficient,
+                  f"allowed < {hf_max} at this shift and pressure angle: the generating "
+                  "rack's tip comes to a point, leaving no root land between the pinion's fillets")
     rack_top_land = _rack_top_land(g)
     if rack_top_land < land_min:
         rack_ha_max = fmt_bound(_rack_addendum_max(g), "upper", ok=lambda v: _rack_top_land_ok(g, v))
-        raise ParamError("rack.addendum_coefficient", g.rack_addendum_coefficient,
-                         f"allowed <= {rack_ha_max}: pointed rack teeth, top land "
-                         f"{rack_top_land:.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
+        found.add("rack.addendum_coefficient", g.rack_addendum_coefficient,
+                  f"allowed <= {rack_ha_max}: pointed rack teeth, top land "
+                  f"{rack_top_land:.3f} mm < {MIN_TOP_LAND_MODULES}·m = {land_min:.3f} mm")
     def root_space_ok(v: float) -> bool:
         at = analysis.with_inputs(g, rack_dedendum_coefficient=v)
         return 2.0 * float(at.rack_half_width(at.rack_root_height)) < at.pitch
 
     if not root_space_ok(g.rack_dedendum_coefficient):
         hf_max = fmt_bound((g.pitch / 2.0 - w0) / (m * tan_a) - x, "upper", ok=root_space_ok, strict=True)
-        raise ParamError("rack.dedendum_coefficient", g.rack_dedendum_coefficient,
-                         f"allowed < {hf_max}: adjacent rack teeth would "
-                         "meet above the rack root line (no tooth space left)")
+        found.add("rack.dedendum_coefficient", g.rack_dedendum_coefficient,
+                  f"allowed < {hf_max}: adjacent rack teeth would "
+                  "meet above the rack root line (no tooth space left)")
     if not layout.bore_fits(g.root_radius):
         z_min = next((n for n in range(g.teeth + 1, TEETH_MAX + 1)
                       if layout.bore_fits(analysis.with_inputs(g, teeth=n).root_radius)), None)
@@ -304,14 +316,15 @@ def _check_tooth_forms(g) -> None:
                 return layout.bore_fits(analysis.with_inputs(g, module_mm=v).root_radius)
 
             m_min = _boundary(module_ok, 50.0, m)
-            raise ParamError("pinion.module_mm", m,
-                             f"allowed >= {fmt_bound(m_min, 'lower', ok=module_ok)} mm at z = {g.teeth}: the root "
-                             "circle "
-                             f"(radius {g.root_radius:.2f} mm) "
-                             f"must clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
-        raise ParamError("pinion.teeth", g.teeth,
-                         f"allowed >= {z_min} at m = {m:g} mm: the root circle (radius {g.root_radius:.2f} mm) must "
-                         f"clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
+            found.add("pinion.module_mm", m,
+                      f"allowed >= {fmt_bound(m_min, 'lower', ok=module_ok)} mm at z = {g.teeth}: the root "
+                      "circle "
+                      f"(radius {g.root_radius:.2f} mm) "
+                      f"must clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
+        else:
+            found.add("pinion.teeth", g.teeth,
+                      f"allowed >= {z_min} at m = {m:g} mm: the root circle (radius {g.root_radius:.2f} mm) must "
+                      f"clear the {layout.PINION_BORE_DIAMETER_MM:g} mm pinion bore")
 
 
 def _rack_top_land(g) -> float:

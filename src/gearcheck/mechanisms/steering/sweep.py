@@ -418,6 +418,23 @@ def _largest(*values: float) -> float:
     return max(finite) if finite else math.nan
 
 
+def _deepest_overlap(kin: Kinematics, rows: list[dict], tol: float) -> list[WorstPose]:
+    """The pose where the sweep found the pinion deepest in the rack, when deeper than the contact
+    tolerance (an interference the verdicts fail on): confirmed on the exact B-rep like the closest
+    approach, so a failed interference verdict rests on the exact solids too."""
+    if not rows:
+        return []
+    row = min(rows, key=lambda r: r["signed_clearance_mm"])
+    if not row["signed_clearance_mm"] < -tol:
+        return []
+    swing = {"out": "forward", "back": "return", "drive": "drive"}[row["swing"]]
+    label = (f"{row['mode']} {sign(row['direction'])}: deepest overlap of the sweep ({swing} swing, "
+             f"{row['pinion_angle_deg']:.3f}°)")
+    return [WorstPose(label, PINION, RACK, kin.pinion(math.radians(row["pinion_angle_deg"])).tolist(),
+                      kin.rack(row["rack_travel_geom_mm"]).tolist(), 0.0, key="deepest_overlap_of_the_sweep",
+                      mesh_overlap=True)]
+
+
 def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results: list, tol: float, bound: float,
             mesh_info: dict, t_start: float, paper: bool = True, drives: dict | None = None) -> SweepOutcome:
     P = an.PAPER
@@ -482,6 +499,7 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         for d, s in ((+1, plus), (-1, minus))
         if (w := tow[d]["worst"]) and not still_moving(s, model.moving_at_end, tol)  # no stop: nothing past it
     ]
+    worst_poses += _deepest_overlap(kin, rows, tol)
     data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
                          summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius))
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}

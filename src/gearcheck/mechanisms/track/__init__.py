@@ -2,7 +2,8 @@
 half pitch): ISO 606 groove form, every other tooth engaging, short tooth under the track plate;
 drive force, pin shear and crush stress.
 
-``calc(params)`` returns the figures beside the paper's printed values (``PAPER``); the model and
+``calc(params)`` returns the figures, beside the paper's printed values (``PAPER``) for the paper's
+own design only (:func:`is_paper_design`); the model and
 its readings are in :mod:`.analysis` and docs/track.md. The mechanism itself (assembly, CAD hook,
 sweep, verdicts, report) is :class:`.mechanism.TrackDrive`.
 """
@@ -28,28 +29,37 @@ PAPER = {
     "tip_diameter_mm": 235.0,
     "max_drive_force_N": 234.0,
 }
-# The paper's own design: the inputs each printed value depends on. A printed value (and a note
-# about it) is shown only beside a design whose inputs match: at another pitch, tooth count or
-# load the paper's number is not a value of that design.
-PAPER_INPUTS = {
-    "chain.pitch_mm": 30.0,
-    "chain.sleeve_diameter_mm": 8.0,
-    "sprocket.teeth": 49,
-    "sprocket.initial_pitch_diameter_mm": 230.0,
-    "sprocket.tip_over_pitch_mm": 0.4,
+# The paper's own design: every input the paper gives (as the template holds it). Its printed
+# values (and the notes about them) stand beside this design only, in calc, summary.json and the
+# report; beside another design they would read as targets. The template's own choices where the
+# paper gives none (marked "chosen": pin segments, ri, re, α, tooth width, middle groove, tip gap,
+# crush allowable, wear tolerance) and the reading of g (the paper's 234 N implies 10; 9.81 is
+# shown against it on purpose) may differ.
+PAPER_DESIGN = {
     "robot.mass_kg": 150.0,
+    "robot.speed_m_s": 1.5,
+    "robot.slope_deg": 45.0,
     "robot.tracks": 4,
     "ground.adhesion_coefficient": 0.7,
     "ground.rolling_resistance_coefficient": 0.08,
-}
-PAPER_DEPENDS = {
-    "teeth_for_initial_pitch_diameter": ("chain.pitch_mm", "sprocket.initial_pitch_diameter_mm"),
-    "pitch_diameter_mm": ("chain.pitch_mm", "sprocket.teeth"),
-    "root_diameter_mm": ("chain.pitch_mm", "sprocket.teeth", "chain.sleeve_diameter_mm"),
-    "tip_diameter_mm": ("chain.pitch_mm", "sprocket.teeth", "sprocket.tip_over_pitch_mm"),
-    # g is not among them: the paper's g = 10 is a reading, and 9.81 is shown against its 234 N
-    "max_drive_force_N": ("robot.mass_kg", "robot.tracks", "ground.adhesion_coefficient",
-                          "ground.rolling_resistance_coefficient"),
+    "chain.pitch_mm": 30.0,
+    "chain.sleeve_diameter_mm": 8.0,
+    "chain.pin_diameter_mm": 3.0,
+    "chain.sleeve_inner_width_mm": 10.8,
+    "chain.pin_support_span_mm": 21.0,
+    "chain.track_width_mm": 60.0,
+    "sprocket.teeth": 49,
+    "sprocket.initial_pitch_diameter_mm": 230.0,
+    "sprocket.tip_over_pitch_mm": 0.4,
+    "sprocket.tooth_rows": 2,
+    "track_plate.required_gap_min_mm": 0.5,
+    "track_plate.required_gap_max_mm": 1.0,
+    "materials.sprocket_E_MPa": 75000.0,
+    "materials.sprocket_poisson": 0.33,
+    "materials.sleeve_E_MPa": 75000.0,
+    "materials.sleeve_poisson": 0.33,
+    "strength.pin_allowable_shear_MPa": 210.0,
+    "strength.loaded_tooth_rows": 1,
 }
 
 
@@ -58,12 +68,16 @@ def _input(params: Params, dotted: str) -> float:
     return float(getattr(getattr(params, section), field))
 
 
-def paper_design(params: Params, key: str | None = None) -> bool:
-    """Whether the inputs behind the paper's printed value ``key`` (all of them without a key)
-    are the paper's own."""
-    names = PAPER_DEPENDS[key] if key is not None else tuple(PAPER_INPUTS)
-    return all(math.isclose(_input(params, n), float(PAPER_INPUTS[n]), rel_tol=1e-12, abs_tol=1e-12)
-               for n in names)
+def is_paper_design(params: Params) -> bool:
+    """The template is the paper's mechanism (every input of :data:`PAPER_DESIGN`): only then do its
+    printed figures stand beside the results."""
+    return all(math.isclose(_input(params, n), float(v), rel_tol=1e-12, abs_tol=1e-12)
+               for n, v in PAPER_DESIGN.items())
+
+
+def _whose(params: Params) -> str:
+    """Who sets the tip-gap window: the paper for its own design, else the template."""
+    return "paper requires" if is_paper_design(params) else "required (track_plate)"
 
 
 def odd_round_up(x: float) -> int:
@@ -80,15 +94,15 @@ def _verdict(ok: bool) -> tuple[float, str]:
 
 
 class _Figures(list):
-    """The figures in table order; ``add`` attaches the paper's value where it has one and the
-    design's inputs behind it are the paper's own (:func:`paper_design`)."""
+    """The figures in table order; ``add`` attaches the paper's value where it has one, beside the
+    paper's own design only (:func:`is_paper_design`)."""
 
     def __init__(self, params: Params):
         super().__init__()
-        self.params = params
+        self.paper = is_paper_design(params)
 
     def add(self, key, label, value, unit, note="", digits=3):
-        paper = PAPER.get(key) if key in PAPER and paper_design(self.params, key) else None
+        paper = PAPER.get(key) if key in PAPER and self.paper else None
         self.append(Figure(key, label, float(value), unit, paper, note, digits))
 
 
@@ -172,8 +186,8 @@ def _plate(params: Params, add, gap) -> None:
         f"from the chosen gap {tp.tip_gap_mm:g} mm")
     ok, word = _verdict(tp.required_gap_min_mm <= measured <= tp.required_gap_max_mm)
     add("tip_gap_mm", "tip gap to plate, measured on the outline", measured, "mm",
-        f"{word}: paper requires {tp.required_gap_min_mm:g}–{tp.required_gap_max_mm:g} mm")
-    add("tip_gap_ok", "tip gap within the paper's window (1 = pass)", ok, "", word, 0)
+        f"{word}: {_whose(params)} {tp.required_gap_min_mm:g}–{tp.required_gap_max_mm:g} mm")
+    add("tip_gap_ok", "tip gap within the required window (1 = pass)", ok, "", word, 0)
 
 
 def _wear(params: Params, add, gap) -> None:
@@ -197,7 +211,7 @@ def _loads(params: Params, add, d: float) -> tuple[float, float]:
     design = max(normal, drive)
     add("weight_N", "robot weight G = m·g", weight, "N", f"g = {r.g_m_s2:g} m/s²", 1)
     drive_note = ("eq. 1 lost: (φ − f)G/n, within 1 % of 234 N at g = 10; no slope term"
-                  if paper_design(params, "max_drive_force_N") else "eq. 1 lost: (φ − f)G/n; no slope term")
+                  if is_paper_design(params) else "eq. 1 lost: (φ − f)G/n; no slope term")
     add("max_drive_force_N", "max drive force per track P_Kφ = (φ − f)G/n", drive, "N", drive_note, 1)
     add("normal_load_per_track_N", "normal load per track G/n", normal, "N", "level ground (largest)", 1)
     add("design_load_N", "design load F = max(G/n, P_Kφ), one tooth", design, "N", digits=1)
@@ -205,7 +219,7 @@ def _loads(params: Params, add, d: float) -> tuple[float, float]:
     climbable = gr.adhesion_coefficient >= need
     ok, word = _verdict(climbable)
     add("required_adhesion_for_slope", f"adhesion needed for {r.slope_deg:g}°: tan α + f", need, "",
-        f"{word}: φ = {gr.adhesion_coefficient:g}" + ("" if climbable else " — the paper's slope cannot be climbed"))
+        f"{word}: φ = {gr.adhesion_coefficient:g}" + ("" if climbable else " — this slope cannot be climbed"))
     add("max_slope_by_adhesion_deg", "steepest slope adhesion allows, atan(φ − f)",
         analysis.max_slope_deg(gr.adhesion_coefficient, gr.rolling_resistance_coefficient), "°", digits=1)
     add("climb_force_needed_N", f"drive force per track to climb {r.slope_deg:g}°",
@@ -265,4 +279,4 @@ def _crush(params: Params, add, design: float, lim) -> None:
     add("crush_ok", "crush stress (1 = pass)", ok, "", word, 0)
 
 
-__all__ = ["MESH_TOL_MM", "PAPER", "PAPER_INPUTS", "Params", "calc", "paper_design"]
+__all__ = ["MESH_TOL_MM", "PAPER", "PAPER_DESIGN", "Params", "calc", "is_paper_design"]

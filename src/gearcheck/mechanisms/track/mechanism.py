@@ -25,8 +25,8 @@ class TrackDrive(Mechanism):
 
     name = "track"
     section = "track"
-    title = ("track drive sprocket for the paper's articulated track (grooves every half pitch): ISO 606 form, "
-             "every other tooth engaging")
+    title = ("track drive sprocket for the paper's articulated track (grooves every half pitch, every other tooth "
+             "engaging; ISO 606 groove form), not a roller-chain sprocket (that is roller_chain)")
     Params = TrackParams
     mesh_tol_mm = MESH_TOL_MM
     template = "eod_track_drive.toml"
@@ -65,9 +65,10 @@ class TrackDrive(Mechanism):
         return track_verdicts(outcome)
 
     def report(self, params: TrackParams, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
+        from gearcheck.mechanisms.track import is_paper_design
         from gearcheck.mechanisms.track.report import track_report
 
-        return track_report(outcome, verdicts)
+        return track_report(outcome, verdicts, paper=is_paper_design(params))
 
     def study_row(self, params: TrackParams, level: str) -> dict[str, float]:
         if level == "exact":

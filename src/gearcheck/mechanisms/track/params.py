@@ -18,6 +18,7 @@ from gearcheck.geometry import iso606
 from gearcheck.geometry import track_chain as tc
 from gearcheck.mechanisms.track import analysis, layout
 from gearcheck.params import ParamError, Section
+from gearcheck.params.problems import Problems
 from gearcheck.params.common import fmt_bound, fmt_range
 
 MIN_TEETH = 7
@@ -29,6 +30,10 @@ PITCH_MAX_MM = 500
 def _f(lo=None, hi=None, *, gt=None, lt=None, unit="", description=""):
     return Field(ge=lo, le=hi, gt=gt, lt=lt, description=description, json_schema_extra={"unit": unit})
 
+
+# The mechanism's scope, named where a roller-chain-like input is refused on a geometric reason.
+SCOPE = "the paper's articulated track: grooves every half pitch"
+ROLLER_CHAIN = f"({SCOPE}; for a standard roller chain use mechanism = \"roller_chain\")"
 
 # Rows that leave less than this (mm) for each groove fill the track: a groove, which must be
 # wider than 0, has no bound left to meet, so the tooth width is the field to change.
@@ -48,9 +53,14 @@ class Ground(Section):
 
 
 class Chain(Section):
-    """The articulated track read as a roller chain (ISO 606 symbols in brackets)."""
+    """The paper's articulated track: grooves every half pitch, a link's two pins two grooves apart,
+    every other tooth engaging (its dimensions named with the ISO 606 symbols in brackets). Not a
+    standard roller chain: for one, use mechanism = "roller_chain"."""
 
-    pitch_mm: float = _f(gt=0, hi=PITCH_MAX_MM, unit="mm", description="track pitch p")
+    pitch_mm: float = _f(gt=0, hi=PITCH_MAX_MM, unit="mm",
+                         description="track pitch p: a link's pins sit two grooves apart (the paper's articulated "
+                                     "track, grooves every half pitch; a standard roller chain is mechanism "
+                                     "roller_chain)")
     sleeve_diameter_mm: float = _f(gt=0, hi=200, unit="mm", description="sleeve (roller) diameter dR [d1]")
     pin_diameter_mm: float = _f(gt=0, hi=100, unit="mm", description="track pin diameter d")
     sleeve_inner_width_mm: float = _f(gt=0, hi=500, unit="mm",
@@ -68,7 +78,9 @@ class Chain(Section):
 
 
 class Sprocket(Section):
-    teeth: int = _f(MIN_TEETH, MAX_TEETH, description="teeth z (odd: every other tooth engages)")
+    teeth: int = _f(MIN_TEETH, MAX_TEETH,
+                    description="teeth z, one groove per tooth, grooves every half track pitch (odd: every other "
+                                "tooth engages and each takes its turn; even: accepted with a warning)")
     initial_pitch_diameter_mm: float = _f(gt=0, hi=10_000, unit="mm",
                                           description="first estimate of d that z is solved from (paper: 230)")
     tip_over_pitch_mm: float = _f(0, 100, unit="mm", description="short-tooth rule: de = d + this (paper: 0.4)")
@@ -113,78 +125,97 @@ class Params(Section):
 
     @model_validator(mode="after")
     def _cross_checks(self) -> Params:
+        """Independent rules are named together (one line each); a rule that needs earlier ones
+        to hold (the ISO ranges need a tooth between the grooves, the tip land needs the ranges, the
+        CAD's layout needs all of them) comes after them."""
         s, c = self.sprocket, self.chain
         z, p, dr = s.teeth, c.pitch_mm, c.sleeve_diameter_mm
-        if not c.pin_diameter_mm < dr:
-            raise ParamError("chain.pin_diameter_mm", c.pin_diameter_mm,
-                             f"allowed < sleeve diameter {fmt_bound(dr, 'upper', None)} mm (the pin runs inside the "
-                             "sleeve)")
-        if not s.initial_pitch_diameter_mm > p:
-            raise ParamError("sprocket.initial_pitch_diameter_mm", s.initial_pitch_diameter_mm,
-                             f"allowed > chain pitch {fmt_bound(p, 'lower', None)} mm")
-        d = iso606.every_other_tooth_pitch_diameter(p, z)
-        chord = iso606.groove_chord(d, z)
-        lim = iso606.seating_limits(dr, z)
-        # No tooth is left when even the smallest ISO seating circles (0.505·dR) of adjacent
-        # grooves touch.
-        if not lim.seating_radius_min_mm * 2.0 < chord:
-            def leaves_tooth(v: float) -> bool:
-                return iso606.seating_limits(v, z).seating_radius_min_mm * 2.0 < chord
+        with Problems() as found:
+            if not c.pin_diameter_mm < dr:
+                found.add("chain.pin_diameter_mm", c.pin_diameter_mm,
+                          f"allowed < sleeve diameter {fmt_bound(dr, 'upper', None)} mm (the pin runs inside the "
+                          "sleeve)")
+            if not s.initial_pitch_diameter_mm > p:
+                found.add("sprocket.initial_pitch_diameter_mm", s.initial_pitch_diameter_mm,
+                          f"allowed > chain pitch {fmt_bound(p, 'lower', None)} mm")
+            d = iso606.every_other_tooth_pitch_diameter(p, z)
+            chord = iso606.groove_chord(d, z)
+            lim = iso606.seating_limits(dr, z)
+            before = len(found.errors)
+            # No tooth is left when even the smallest ISO seating circles (0.505·dR) of adjacent
+            # grooves touch.
+            if not lim.seating_radius_min_mm * 2.0 < chord:
+                def leaves_tooth(v: float) -> bool:
+                    return iso606.seating_limits(v, z).seating_radius_min_mm * 2.0 < chord
 
-            dr_max = fmt_bound(chord / 1.01, "upper", ok=leaves_tooth, strict=True)
-            if not float(dr_max) > 0:  # no sleeve fits: the pitch is what is out of range
-                raise _pitch_leaves_no_tooth(z, p, dr, chord)
-            raise ParamError("chain.sleeve_diameter_mm", dr,
-                             f"allowed < {dr_max} mm at z = {z}, p = {p:g} mm: seating circles "
-                             f"(0.505·dR) of adjacent grooves {chord:.3f} mm apart must leave a tooth")
-        ri_hi = min(lim.seating_radius_max_mm, 0.5 * chord)
-        if not lim.seating_radius_min_mm <= s.seating_radius_mm <= ri_hi:
-            bound = "" if ri_hi == lim.seating_radius_max_mm else f" (capped at half the groove chord {chord:.3f} mm)"
-            raise ParamError("sprocket.seating_radius_mm", s.seating_radius_mm,
-                             f"allowed {fmt_range(lim.seating_radius_min_mm, ri_hi)} mm: ISO 606 limits "
-                             f"for dR = {dr:g} mm{bound}")
-        if not lim.flank_radius_min_mm <= s.flank_radius_mm <= lim.flank_radius_max_mm:
-            raise ParamError("sprocket.flank_radius_mm", s.flank_radius_mm,
-                             f"allowed {fmt_range(lim.flank_radius_min_mm, lim.flank_radius_max_mm, 2)} mm: "
-                             f"ISO 606 limits for dR = {dr:g} mm, z = {z}")
-        if not lim.seating_angle_min_deg <= s.seating_angle_deg <= lim.seating_angle_max_deg:
-            raise ParamError("sprocket.seating_angle_deg", s.seating_angle_deg,
-                             f"allowed {fmt_range(lim.seating_angle_min_deg, lim.seating_angle_max_deg, 2)}°: "
-                             f"ISO 606 limits for z = {z}")
-        self._check_tip_land(d)
-        self._check_widths_and_loads()
+                dr_max = fmt_bound(chord / 1.01, "upper", ok=leaves_tooth, strict=True)
+                if not float(dr_max) > 0:  # no sleeve fits: the pitch is what is out of range
+                    found.extend(_pitch_leaves_no_tooth(z, p, dr, chord))
+                else:
+                    found.add("chain.sleeve_diameter_mm", dr,
+                              f"allowed < {dr_max} mm at z = {z}, p = {p:g} mm: seating circles "
+                              f"(0.505·dR) of adjacent grooves {chord:.3f} mm apart must leave a tooth {ROLLER_CHAIN}")
+            else:
+                self._check_iso_ranges(lim, chord, found)
+            if len(found.errors) == before:  # the tip land is drawn from a valid groove form
+                try:
+                    self._check_tip_land(d)
+                except ParamError as exc:
+                    found.extend(exc)
+            self._check_widths_and_loads(found)
         self._check_buildable()
         return self
 
-    def _check_widths_and_loads(self) -> None:
-        """Tooth width, rows and track width; loaded rows; adhesion; the paper's gap window."""
+    def _check_iso_ranges(self, lim: iso606.SeatingLimits, chord: float, found: Problems) -> None:
+        """The chosen ri, re and α within their ISO 606 limits (each on its own)."""
+        s, dr, z = self.sprocket, self.chain.sleeve_diameter_mm, self.sprocket.teeth
+        ri_hi = min(lim.seating_radius_max_mm, 0.5 * chord)
+        if not lim.seating_radius_min_mm <= s.seating_radius_mm <= ri_hi:
+            bound = ("" if ri_hi == lim.seating_radius_max_mm
+                     else f" (capped at half the groove chord {chord:.3f} mm) {ROLLER_CHAIN}")
+            found.add("sprocket.seating_radius_mm", s.seating_radius_mm,
+                      f"allowed {fmt_range(lim.seating_radius_min_mm, ri_hi)} mm: ISO 606 limits "
+                      f"for dR = {dr:g} mm{bound}")
+        if not lim.flank_radius_min_mm <= s.flank_radius_mm <= lim.flank_radius_max_mm:
+            found.add("sprocket.flank_radius_mm", s.flank_radius_mm,
+                      f"allowed {fmt_range(lim.flank_radius_min_mm, lim.flank_radius_max_mm, 2)} mm: "
+                      f"ISO 606 limits for dR = {dr:g} mm, z = {z}")
+        if not lim.seating_angle_min_deg <= s.seating_angle_deg <= lim.seating_angle_max_deg:
+            found.add("sprocket.seating_angle_deg", s.seating_angle_deg,
+                      f"allowed {fmt_range(lim.seating_angle_min_deg, lim.seating_angle_max_deg, 2)}°: "
+                      f"ISO 606 limits for z = {z}")
+
+    def _check_widths_and_loads(self, found: Problems) -> None:
+        """Tooth width, rows and track width; loaded rows; adhesion; the required gap window (each on
+        its own)."""
         s, c = self.sprocket, self.chain
         p = c.pitch_mm
         bf_max = iso606.iso_tooth_width_max(c.sleeve_inner_width_mm, p)
-        if not s.tooth_width_mm <= bf_max:
-            raise ParamError("sprocket.tooth_width_mm", s.tooth_width_mm,
-                             f"allowed <= {fmt_bound(bf_max, 'upper')} mm: ISO 606 bf1 max for "
-                             f"b1 = {c.sleeve_inner_width_mm:g} mm")
+        pitch_named = any(e.field == "chain.pitch_mm" for e in found.errors)  # bf1 max follows from p
+        if not pitch_named and not s.tooth_width_mm <= bf_max:
+            found.add("sprocket.tooth_width_mm", s.tooth_width_mm,
+                      f"allowed <= {fmt_bound(bf_max, 'upper')} mm: ISO 606 bf1 max for "
+                      f"b1 = {c.sleeve_inner_width_mm:g} mm")
         if not c.sleeve_inner_width_mm < c.pin_support_span_mm:
             b2 = fmt_bound(c.pin_support_span_mm, "upper", None)
-            raise ParamError("chain.sleeve_inner_width_mm", c.sleeve_inner_width_mm,
-                             f"allowed < pin support span b2 = {b2} mm")
+            found.add("chain.sleeve_inner_width_mm", c.sleeve_inner_width_mm,
+                      f"allowed < pin support span b2 = {b2} mm")
         total = s.tooth_rows * s.tooth_width_mm + (s.tooth_rows - 1) * s.middle_groove_width_mm
         if not total <= c.track_width_mm:
-            raise self._width_error(total)
+            found.extend(self._width_error(total))
         if not self.strength.loaded_tooth_rows <= s.tooth_rows:
-            raise ParamError("strength.loaded_tooth_rows", self.strength.loaded_tooth_rows,
-                             f"allowed 1 to {s.tooth_rows} (sprocket.tooth_rows)")
+            found.add("strength.loaded_tooth_rows", self.strength.loaded_tooth_rows,
+                      f"allowed 1 to {s.tooth_rows} (sprocket.tooth_rows)")
         g = self.ground
         if not g.adhesion_coefficient > g.rolling_resistance_coefficient:
             f = fmt_bound(g.rolling_resistance_coefficient, "lower", None)
-            raise ParamError("ground.adhesion_coefficient", g.adhesion_coefficient,
-                             f"allowed > rolling resistance f = {f} (else the track has no drive force)")
+            found.add("ground.adhesion_coefficient", g.adhesion_coefficient,
+                      f"allowed > rolling resistance f = {f} (else the track has no drive force)")
         t = self.track_plate
         if not t.required_gap_min_mm <= t.required_gap_max_mm:
             gap_max = fmt_bound(t.required_gap_max_mm, "upper", None)
-            raise ParamError("track_plate.required_gap_min_mm", t.required_gap_min_mm,
-                             f"allowed <= required_gap_max_mm = {gap_max} mm")
+            found.add("track_plate.required_gap_min_mm", t.required_gap_min_mm,
+                      f"allowed <= required_gap_max_mm = {gap_max} mm")
 
     def _width_error(self, total: float) -> ParamError:
         """Rows and grooves wider than the track: the middle groove's own bound when the rows
@@ -237,7 +268,8 @@ class Params(Section):
             allowed = _allowed_teeth(z, lambda n: fits(n) and _wrap_fits(n, p))
             raise ParamError("sprocket.teeth", z,
                              f"{allowed} at p = {p:g} mm: the {bore:g} mm shaft bore must lie under the "
-                             f"middle groove floor, {depth:g} mm below the root circle (sprocket too small)") from None
+                             f"middle groove floor, {depth:g} mm below the root circle (sprocket too small) "
+                             f"{ROLLER_CHAIN}") from None
         try:
             layout.default_wrap(z, p)
         except ValueError as exc:
@@ -245,7 +277,7 @@ class Params(Section):
             raise ParamError("sprocket.teeth", z,
                              f"{allowed}: the chain segment built at θ = 0 "
                              f"({layout.DEFAULT_WRAP_ANGLE_DEG:g}° wrap plus {layout.DEFAULT_RUN_LINKS} links on "
-                             f"each run) does not fit: {exc}") from None
+                             f"each run) does not fit: {exc} {ROLLER_CHAIN}") from None
         try:
             layout.link_geometry(self, spec.gap)
         except ValueError:
@@ -294,11 +326,12 @@ class Params(Section):
                                  f"no value >= 0 allowed: the flanks of adjacent grooves meet "
                                  f"{(d - limit) / 2:.3f} mm below the pitch circle (sleeve "
                                  f"{self.chain.sleeve_diameter_mm:g} mm too large for the "
-                                 f"{iso606.groove_chord(d, s.teeth):.3f} mm groove chord with this ri, re, α)")
+                                 f"{iso606.groove_chord(d, s.teeth):.3f} mm groove chord with this ri, re, α) "
+                                 f"{ROLLER_CHAIN}")
             raise ParamError("sprocket.tip_over_pitch_mm", s.tip_over_pitch_mm,
                              f"allowed < {fmt_bound(limit - d, 'upper', ok=lambda v: d + v < limit, strict=True)} mm: "
                              "the flanks of adjacent grooves meet "
-                             f"{(limit - d) / 2:.3f} mm above the pitch circle, no tip land above that")
+                             f"{(limit - d) / 2:.3f} mm above the pitch circle, no tip land above that {ROLLER_CHAIN}")
         try:
             iso606.tooth_gap(d, s.teeth, s.seating_radius_mm, s.flank_radius_mm, s.seating_angle_deg,
                              d + s.tip_over_pitch_mm)
@@ -319,7 +352,7 @@ def _pitch_leaves_no_tooth(z: int, p: float, dr: float, chord: float) -> ParamEr
     p_min = fmt_bound(needed / per_mm, "lower", ok=leaves_tooth, strict=True)
     return ParamError("chain.pitch_mm", p,
                       f"out of range: allowed >{p_min} to {PITCH_MAX_MM} mm at z = {z}, dR = {dr:g} mm: seating "
-                      f"circles (0.505·dR) of adjacent grooves {chord:.3g} mm apart must leave a tooth")
+                      f"circles (0.505·dR) of adjacent grooves {chord:.3g} mm apart must leave a tooth {ROLLER_CHAIN}")
 
 
 def _largest_joining_offset(pitch_mm: float, sleeve_diameter_mm: float, track_width_mm: float) -> float:

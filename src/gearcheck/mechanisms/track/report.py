@@ -36,9 +36,22 @@ def rows(d: TrackSweep) -> list[dict]:
     ]
 
 
-def comparisons(d: TrackSweep) -> list[Comparison]:
-    """The table's rows at 4 decimals (0.1 µm), the mesh sweep within its error bound agreeing."""
-    return [dataclasses.replace(c, digits=4 if c.unit == "mm" else 3, tolerance=d.bound) for c in _comparisons(d)]
+def comparisons(d: TrackSweep, paper: bool = True) -> list[Comparison]:
+    """The table's rows at 4 decimals (0.1 µm), the mesh sweep within its error bound agreeing.
+    ``paper``: the design is the paper's own (its gap window then stands in the paper column)."""
+    rows = [dataclasses.replace(c, digits=4 if c.unit == "mm" else 3, tolerance=d.bound) for c in _comparisons(d)]
+    return rows if paper else [_without_paper(c) for c in rows]
+
+
+def _without_paper(c: Comparison) -> Comparison:
+    """A row beside another design: the window is the template's requirement, not a paper figure."""
+    if c.paper is None:
+        return dataclasses.replace(c, note=c.note.replace("paper window", "required window"))
+    sign = "≥" if c.paper_is == "min" else "≤"
+    what = ("min tip-to-plate over the sweep" if c.paper_is == "min" else "largest seated tip gap")
+    key = "required_gap_min_mm" if c.paper_is == "min" else "required_gap_max_mm"
+    note = f"required {sign} {c.paper:g} mm (track_plate.{key})" + (f"; {c.note}" if c.note else "")
+    return dataclasses.replace(c, label=what, paper=None, paper_is="value", note=note)
 
 
 def _comparisons(d: TrackSweep) -> list[Comparison]:
@@ -101,13 +114,14 @@ def _wear_notes(d: TrackSweep) -> list[str]:
     ]
 
 
-def plots(d: TrackSweep) -> list[Plot]:
+def plots(d: TrackSweep, paper: bool = True) -> list[Plot]:
     model = d.model
     x = [float(np.degrees(a)) for a in d.angles]
     row_sleeve, row_plate = d.sleeve_d.min(axis=1), d.plate_d.min(axis=1)
     off_s, off_p = rowmin(d.sleeve_d, ~d.sleeve_seated), rowmin(d.plate_d, ~d.links_seated)
     ex_row_s, ex_row_p = d.ex_sleeve.min(axis=1), d.ex_plate.min(axis=1)
     cycle_marks = [("cycle start θ = 0", 0.0), (f"one cycle β = {d.cycle_deg:.3f}°", d.cycle_deg)]
+    floor = "paper's minimum" if paper else "required minimum"
     seat = model.seating_clearance_mm
     sleeve_series = [Series("min over all sleeves (mesh)", x, [float(v) for v in row_sleeve]),
                      Series("min over sleeves off their seats (mesh)", x, [finite(v) for v in off_s]),
@@ -122,10 +136,11 @@ def plots(d: TrackSweep) -> list[Plot]:
               Series("min over links off their seats (mesh)", x, [finite(v) for v in off_p]),
               Series("min over all links (exact 2-D)", x, [float(v) for v in ex_row_p], "points")],
              markers=cycle_marks,
-             hlines=[(f"paper minimum {model.required_gap_min_mm:g} mm", model.required_gap_min_mm),
+             hlines=[(f"{'paper' if paper else 'required'} minimum {model.required_gap_min_mm:g} mm",
+                      model.required_gap_min_mm),
                      (f"template gap {model.tip_gap_mm:g} mm", model.tip_gap_mm)],
              caption="The least distance sits at seated links, flat at the template gap; links swinging in or "
-                     "out lift away from the tip (the peaks), so the paper's minimum is decided at the seat."),
+                     f"out lift away from the tip (the peaks), so the {floor} is decided at the seat."),
         Plot("Track: tooth–sleeve clearance against sprocket angle", "sprocket angle θ (°)", "clearance (mm)",
              sleeve_series, markers=cycle_marks, hlines=[(f"ri − R = {seat:.3f} mm", seat)],
              caption="Whole range: sleeves approaching and leaving their seats (the peaks) stay well clear; the "
@@ -183,6 +198,8 @@ def notes(d: TrackSweep) -> list[str]:
     ]
 
 
-def track_report(outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
+def track_report(outcome: SweepOutcome, verdicts: Sequence[Verdict], paper: bool = True) -> Report:
+    """``paper``: the design is the paper's own (:func:`gearcheck.mechanisms.track.is_paper_design`):
+    only then does the paper's gap window stand as a paper figure."""
     d: TrackSweep = outcome.data
-    return Report(rows(d), comparisons(d), plots(d), notes(d))
+    return Report(rows(d), comparisons(d, paper), plots(d, paper), notes(d))

@@ -61,7 +61,7 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                     "exact_min_tooth_sleeve_mm": ex_min_sleeve.value, "min_tip_plate_mm": min_plate.value,
                     "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}, evidence=on_mesh,
                    shortfall=interference),
-        Verdict.of("seated_tip_gap_in_window", "seated-link tip gap inside the paper's window", gap_in_window,
+        Verdict.of("seated_tip_gap_in_window", "seated-link tip gap inside the required window", gap_in_window,
                    f"{seated_gap.value:.4f}–{d.seated_gap_max:.4f} mm over {int(d.links_seated.sum())} seated link "
                    f"poses (template {model.tip_gap_mm:g}), window {model.required_gap_min_mm:g}–"
                    f"{model.required_gap_max_mm:g} mm; bound {bound:.3f} mm",
@@ -69,7 +69,7 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                     "window_min_mm": model.required_gap_min_mm, "window_max_mm": model.required_gap_max_mm},
                    evidence="mesh sweep (seated links), proven from both sides; exact 2-D model agrees",
                    shortfall=gap_short),
-        Verdict.of("min_tip_plate_distance", "tip-to-plate distance over the sweep ≥ the paper's minimum",
+        Verdict.of("min_tip_plate_distance", "tip-to-plate distance over the sweep ≥ the required minimum",
                    min_plate_ok,
                    f"min {min_plate.value:.4f} mm at {d.where(min_plate)}, limit ≥ {model.required_gap_min_mm:g} mm; "
                    f"bound {bound:.3f} mm",
