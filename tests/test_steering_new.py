@@ -222,3 +222,18 @@ def test_new_then_check_gives_a_verdict(tmp_path, capsys, m, z):
     shown = " ".join(html.unescape(re.sub(r"<[^>]+>", " ", re.sub(r"<(svg|script|style)\b.*?</\1>", "", page, flags=re.S))).split())
     for printed in ("ADAMS", "75.32", "110.20", "62.11", "test 109.5", "Paper, model"):
         assert printed not in shown, printed
+
+
+def test_a_derived_value_set_is_kept_and_noted_as_given():
+    """--set on a derived value (hS4, RS1, hS2) is an input: written as given, noted so, and the rest
+    derived from it (hS6/hS8 under the tip lands of the RS1 given)."""
+    design = gearcheck.new("steering", module=5, teeth=34, overrides=["trim.hS4_mm=31.5",
+                                                                       "pinion.topped_radius_mm=82",
+                                                                       "trim.hS2_mm=33.7"])
+    p = design.params
+    assert (p.trim.hS4_mm, p.pinion.topped_radius_mm, p.trim.hS2_mm) == (31.5, 82.0, 33.7)
+    from gearcheck.drafting import draft
+
+    text = draft("steering", ["trim.hS4_mm=31.5", "pinion.topped_radius_mm=82"], module=5, teeth=34).toml()
+    assert re.search(r"hS4_mm = 31.5 +# as given: ε = 1\.20\d\d", text)
+    assert re.search(r"topped_radius_mm = 82.0 +# RS1 as given", text)

@@ -231,12 +231,20 @@ def _untrimmed(v: dict[str, Any], notes: dict[str, str], given: Mapping[str, Any
     return an.with_inputs(g, topped_radius_mm=g.tip_radius, hS2_mm=top, hS4_mm=top, hS6_mm=top, hS8_mm=top)
 
 
+def _given(given: Mapping[str, Any], notes: dict[str, str], key: str, note: str = "as given") -> float | None:
+    """A derived value the user set with --set (noted as given), or None: derive it."""
+    if key not in given:
+        return None
+    notes[key] = note
+    return float(given[key])
+
+
 def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str],
                  given: Mapping[str, Any]) -> RackPinionGeometry:
     """Steps 4–6: hS4 from ε, RS1 from the target, hS2 for the shortest stroke."""
     top, eps = g.rack_top_height, v["trim.min_contact_ratio"]
-    if "trim.hS4_mm" in given:
-        hs4 = float(given["trim.hS4_mm"])
+    hs4 = _given(given, notes, "trim.hS4_mm")
+    if hs4 is not None:
         notes["trim.hS4_mm"] = f"as given: ε = {an.contact_ratio(g, hs4):.4f}"
     else:
         hs4 = contact_ratio_height(g, eps)
@@ -246,10 +254,8 @@ def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str]
         notes["trim.hS4_mm"] = (f"ε = trim.min_contact_ratio = {eps:g} (eqs 1–2 inverted), rounded up: "
                                 f"ε = {an.contact_ratio(g, hs4):.4f}")
     g = an.with_inputs(g, hS4_mm=hs4)
-    if "pinion.topped_radius_mm" in given:
-        rs1 = float(given["pinion.topped_radius_mm"])
-        notes["pinion.topped_radius_mm"] = "RS1 as given"
-    else:
+    rs1 = _given(given, notes, "pinion.topped_radius_mm", "RS1 as given")
+    if rs1 is None:
         aim = v["targets.continuous_angle_deg"] + DRIVE_MARGIN_DEG
         rs1 = topped_radius_for_angle(g, aim)
         if math.isnan(rs1):
@@ -258,10 +264,8 @@ def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str]
         notes["pinion.topped_radius_mm"] = (f"RS1: G1's contact reaches S1 at {aim:g}° (target + "
                                             f"{DRIVE_MARGIN_DEG:g}°, eq 17 solved), rounded up")
     g = an.with_inputs(g, topped_radius_mm=rs1)
-    if "trim.hS2_mm" in given:
-        hs2 = float(given["trim.hS2_mm"])
-        notes["trim.hS2_mm"] = "as given"
-    else:
+    hs2 = _given(given, notes, "trim.hS2_mm")
+    if hs2 is None:
         hs2, how = shortest_stroke_height(g)
         if math.isnan(hs2):
             raise NoDesign(how)
