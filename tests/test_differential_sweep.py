@@ -263,15 +263,15 @@ def test_mesh_sweep_agrees_with_the_exact_flanks(build_bodies):
     assert "mesh_agrees_with_exact" not in s  # the verdict only, not a duplicate in the summary
     assert s["max_mesh_exact_contact_deviation_arcmin"] <= s["mesh_error_bound_arcmin"] + 0.02 * 9.0
     # meshes overstate clearance (chords inside convex flanks), never by more than the bound
-    assert s["geom_warm_play_min_arcmin"] >= s["exact_warm_play_min_arcmin"] - 1e-3
-    assert s["geom_cold_play_min_arcmin"] > 0.0
+    assert s["geom_play_min_arcmin_at_warm"] >= s["exact_play_min_arcmin_at_warm"] - 1e-3
+    assert s["geom_play_min_arcmin_at_cold"] > 0.0
     assert result.passed
     assert all(v.evidence for v in result.verdicts)
     # the finding: the geometry loses more than the paper's first-order model
     assert s["geom_cold_drop_per_side_arcmin"] > s["model_cold_drop_per_side_arcmin"]
     # no shim binds cold (the paper shims for this reason)
     study = s["shim_study"]
-    assert study["geom_cold_play_min_arcmin"][study["shims_mm"].index(0.0)] < 0.0
+    assert study["geom_play_min_arcmin_at_cold"][study["shims_mm"].index(0.0)] < 0.0
     # the template's shim is also measured at the operating range's ends and the storage minimum,
     # each checked against the exact flanks; the storage minimum binds (a warning, not a failure)
     states = s["states"]

@@ -328,7 +328,7 @@ def test_calc_shows_the_exact_range_beside_the_linear_model(template, grid):
     assert linear.value == 1.0 and "PASS" not in linear.note and "binds in storage" in linear.note
     assert "linear model" in linear.label
     assert figs["exact_range_verdict"].value == 0.5 and figs["exact_range_verdict"].note.startswith("WARN")
-    assert figs["exact_play_per_side_min_arcmin_at_storage_min"].value == pytest.approx(grid.at("storage_min"))
+    assert figs["exact_play_min_arcmin_at_storage_min"].value == pytest.approx(grid.at("storage_min"))
     assert figs["exact_binding_onset_C"].value == pytest.approx(grid.cold_onset_C, abs=2 * tp.ONSET_TOL_K)
     assert figs["backlash_total_min_at_storage_min_arcmin"].value > 0.0  # the linear model, free
     assert "binds" in figs["backlash_total_min_at_storage_min_arcmin"].note

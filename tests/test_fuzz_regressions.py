@@ -46,7 +46,7 @@ STEERING_SEED_2000091 = {  # S6 3 mm below S2: the first tooth's top slopes 36°
     "rack": {"first_tooth": -5, "last_tooth": 5, "addendum_coefficient": 0.989, "dedendum_coefficient": 1.384},
     "layout": {"centre_to_datum_mm": 54.473},
     "trim": {"min_contact_ratio": 1.252, "hS2_mm": 11.0792, "hS4_mm": 11.1141, "hS6_mm": 8.0621, "hS8_mm": 9.7966},
-    "targets": {"continuous_angle_deg": 16.52},
+    "targets": {"continuous_drive_deg": 16.52},
     "towing": {"max_angle_deg": 110.2},
 }
 
@@ -57,7 +57,7 @@ STEERING_SEED_2000084 = {  # S2 2.8 mm above S4/S6: corner pushes faster than 1.
     "rack": {"first_tooth": -4, "last_tooth": 4, "addendum_coefficient": 1.051, "dedendum_coefficient": 1.21},
     "layout": {"centre_to_datum_mm": 160.631},
     "trim": {"min_contact_ratio": 1.091, "hS2_mm": 55.2, "hS4_mm": 52.3712, "hS6_mm": 51.7331, "hS8_mm": 53.3557},
-    "targets": {"continuous_angle_deg": 14.97},
+    "targets": {"continuous_drive_deg": 14.97},
     "towing": {"max_angle_deg": 115.23},
 }
 

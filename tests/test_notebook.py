@@ -23,15 +23,15 @@ ROOT = Path(__file__).resolve().parents[1]
 
 def test_calc_is_a_readable_mapping():
     calc = gearcheck.load(ROOT / "templates" / "nose_wheel_steering.toml").calc()
-    assert calc.keys() == [f.key for f in calc.figures] and "continuous_angle_deg" in calc
+    assert calc.keys() == [f.key for f in calc.figures] and "continuous_drive_deg" in calc
     assert "no_such_key" not in calc
-    with pytest.raises(KeyError, match=r"no figure 'continuous_angle'; did you mean 'continuous_angle_deg'"):
-        calc["continuous_angle"]
-    assert calc.figure("continuous_angle_deg").unit == "deg"
+    with pytest.raises(KeyError, match=r"no figure 'continuous_drive'; did you mean 'continuous_drive_deg'"):
+        calc["continuous_drive"]
+    assert calc.figure("continuous_drive_deg").unit == "deg"
     text = repr(calc)
     assert text.startswith("<Calc steering: ") and len(text) < 200 and "\n" not in text
     page = calc._repr_html_()
-    assert page.count("<tr>") == len(calc.figures) + 1 and "<code>continuous_angle_deg</code>" in page
+    assert page.count("<tr>") == len(calc.figures) + 1 and "<code>continuous_drive_deg</code>" in page
 
 
 def test_html_escapes_and_drops_paper_columns_without_paper_values():
@@ -94,8 +94,8 @@ def test_the_example_notebook_runs_headless(tmp_path):
     # progress, stage by stage, while the check ran
     assert "sweeping nose_wheel_steering …" in streams and "(100 %)" in streams and "done in" in streams
     # the tables: calc's figures, the check's verdicts with their badges
-    assert "<code>continuous_angle_deg</code>" in html_out and badge("pass") in html_out
-    assert "did you mean 'continuous_angle_deg'" in streams
+    assert "<code>continuous_drive_deg</code>" in html_out and badge("pass") in html_out
+    assert "did you mean 'continuous_drive_deg'" in streams
     assert (tmp_path / "notebook_steering" / "report.html").is_file()
     hs6 = next(o for o in nb.cells[-1].outputs if o.get("output_type") == "execute_result")
     assert math.isfinite(float(hs6["data"]["text/plain"]))

@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -10,6 +11,8 @@ from gearcheck.design import load_template
 from gearcheck.mechanism import names as mechanism_names
 from gearcheck.params import ParamError
 from gearcheck.params.common import parse_override
+
+ROOT = Path(__file__).resolve().parents[1]
 
 TEMPLATE_FILES = {
     "differential": "zhurong_differential.toml",
@@ -149,3 +152,23 @@ def test_optional_name_must_be_a_folder_name(tmp_path, templates_dir):
     bad.write_text('name = "../escape"\n' + text)
     with pytest.raises(ParamError, match="name = '../escape'"):
         load_template(bad)
+
+
+def test_a_renamed_key_still_loads_with_a_warning(tmp_path, caplog):
+    """targets.continuous_angle_deg became targets.continuous_drive_deg (one name per concept):
+    an old template loads, with a warning naming the new key; both names at once is an error."""
+    import logging
+
+    import gearcheck
+    from gearcheck.params.common import ParamError
+
+    text = (ROOT / "templates" / "nose_wheel_steering.toml").read_text()
+    old = tmp_path / "old.toml"
+    old.write_text(text.replace("continuous_drive_deg", "continuous_angle_deg"))
+    with caplog.at_level(logging.WARNING, logger="gearcheck"):
+        design = gearcheck.load(old)
+    assert design.params.targets.continuous_drive_deg == 60.0
+    assert "continuous_angle_deg is now called continuous_drive_deg" in caplog.text
+    with pytest.raises(ParamError, match="continuous_angle_deg is the old name of continuous_drive_deg"):
+        gearcheck.load(ROOT / "templates" / "nose_wheel_steering.toml",
+                       overrides={"targets.continuous_angle_deg": 61.0})

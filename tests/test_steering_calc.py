@@ -87,7 +87,7 @@ def test_tangent_constructions_allow_more_than_machined(figs):
 def test_engagement_angles(figs):
     assert figs["phi_S1_deg"] == pytest.approx(62.67, abs=0.1)
     assert figs["phi_S6_deg"] == pytest.approx(62.33, abs=0.1)
-    assert figs["continuous_angle_deg"] == pytest.approx(62.33, abs=0.1)
+    assert figs["continuous_drive_deg"] == pytest.approx(62.33, abs=0.1)
     # the paper's 62.11° and αS6 = 21.42° come back at its own-lines hS6 = 25.38
     assert figs["phi_S6_paper_hS6_deg"] == pytest.approx(62.11, abs=0.02)
     assert figs["continuous_margin_deg"] > 0
@@ -107,7 +107,7 @@ def test_towing_curve_check_points(figs):
     assert figs["towing_travel_mm_at_adams_angle"] == pytest.approx(110.03, abs=0.05)  # ADAMS 75.89° / 110.05
     assert figs["towing_travel_mm_at_max_angle"] == pytest.approx(figs["rack_travel_at_disengage_mm"], abs=1e-4)
     assert figs["reengage_angle_deg"] == pytest.approx(74.05, abs=0.1)
-    assert figs["towing_grazing_span_deg"] == pytest.approx(4.1, abs=0.05)
+    assert figs["grazing_span_deg"] == pytest.approx(4.1, abs=0.05)
     assert figs["towing_max_overlap_mm"] <= 1e-6
 
 
@@ -258,7 +258,7 @@ def test_bad_inputs_rejected_in_one_line(override, field):
 def test_cli_json_has_required_keys(capsys):
     assert main(["calc", str(TEMPLATE), "--json"]) == 0
     data = json.loads(capsys.readouterr().out)["steering"]
-    for key in ("contact_ratio", "hS4_mm", "hS6_max_mm", "hS8_max_mm", "phi_S1_deg", "continuous_angle_deg",
+    for key in ("contact_ratio", "hS4_mm", "hS6_max_mm", "hS8_max_mm", "phi_S1_deg", "continuous_drive_deg",
                 "disengage_angle_deg", "rack_travel_at_disengage_mm", "travel_S3S4_mm", "RS1_solved_mm",
                 "hS2_solved_mm", "reengage_angle_deg", "towing_travel_mm_at_068deg"):
         assert math.isfinite(data[key]), key
@@ -283,7 +283,7 @@ def test_template_is_inputs_only():
     ("pinion.topped_radius_mm=82.9",),
     ("trim.hS2_mm=24.1", "trim.hS6_mm=24.6"),
     ("trim.min_contact_ratio=1.3",),  # no hS2 solves eq (4)
-    ("targets.continuous_angle_deg=70",),  # no RS1 reaches the target
+    ("targets.continuous_drive_deg=70",),  # no RS1 reaches the target
 ])
 def test_calc_json_has_no_null_and_no_nan(capsys, overrides):
     """calc --json never holds null or NaN: a figure without a value is left out of the JSON and

@@ -20,7 +20,7 @@ from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.mechanisms.steering import handover as ho
 
 TEMPLATE = "nose_wheel_steering"
-HANDOVER_GAP = ["trim.hS2_mm=24.1", "trim.hS6_mm=24.6", "targets.continuous_angle_deg=60.5"]
+HANDOVER_GAP = ["trim.hS2_mm=24.1", "trim.hS6_mm=24.6", "targets.continuous_drive_deg=60.5"]
 # Contact ends on mesh-like outlines (exact vertices, the rack at r·φ) against the exact intervals:
 # the involute through the vertices is the flank, so only round-off is left (measured ≤ 1e-6°).
 EVENT_TOL_DEG = 1e-3
@@ -206,7 +206,7 @@ def test_the_sweep_sees_the_handover_gap(templates_dir, tmp_path):
         gap = side["geom_towing_gap_deg"]
         assert gap[0] == pytest.approx(a, abs=SWEPT_TOL_DEG) and gap[1] == pytest.approx(b, abs=SWEPT_TOL_DEG)
         assert side["geom_towing_gap_poses"] >= 3
-        assert side["geom_towing_drive_deg"] < design.params.targets.continuous_angle_deg
+        assert side["geom_towing_drive_deg"] < design.params.targets.continuous_drive_deg
     assert not v.passed
     assert v.figures["mesh_deg"] < v.figures["target_deg"] and v.figures["model_deg"] < v.figures["target_deg"]
     assert v.figures["model_deg"] == pytest.approx(a, abs=1e-6)

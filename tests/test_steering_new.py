@@ -121,7 +121,7 @@ def test_topped_radius_meets_the_target(made):
     assert hand.phi_s1(rs1 - 0.001) < aim  # the smallest, to 1 µm
     # the model (every tooth pair, every hand-over, towing and power) drives past the target
     figs = gearcheck.load(d).calc()
-    assert figs["continuous_angle_deg"] >= TARGET_DEG
+    assert figs["continuous_drive_deg"] >= TARGET_DEG
 
 
 def test_shortest_stroke_and_tangent_tops(made):
@@ -177,10 +177,10 @@ def test_overrides_are_inputs_of_the_chain():
     hand = Hand(5.0, 34, alpha["rack"]["first_tooth"], alpha_deg=20.0)
     assert alpha["pinion"]["pressure_angle_deg"] == 20.0
     assert EPS <= hand.contact_ratio(alpha["trim"]["hS4_mm"]) <= EPS + 5e-4
-    aim = _data(3.0, 56, "targets.continuous_angle_deg=55")
+    aim = _data(3.0, 56, "targets.continuous_drive_deg=55")
     assert Hand(3.0, 56, aim["rack"]["first_tooth"]).phi_s1(aim["pinion"]["topped_radius_mm"]) == \
         pytest.approx(55.0 + MARGIN_DEG, abs=0.01)
-    assert gearcheck.load(aim).calc()["continuous_angle_deg"] >= 55.0
+    assert gearcheck.load(aim).calc()["continuous_drive_deg"] >= 55.0
 
 
 def test_changed_design_calc_has_no_paper_values(made, capsys):

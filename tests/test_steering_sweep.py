@@ -190,10 +190,10 @@ def test_continuous_drive_limit_is_where_the_contact_reaches_S6(checked):
     g = an.geometry_from_params(params)
     model = math.degrees(an.continuous_power_angle(g))
     assert model == pytest.approx(62.33, abs=0.01)
-    assert result.summary["model_continuous_angle_deg"] == pytest.approx(model)
+    assert result.summary["model_continuous_drive_deg"] == pytest.approx(model)
     for s in _both(result.summary):
-        assert s["geom_continuous_angle_deg"] == pytest.approx(model, abs=CONTINUOUS_TOL_DEG)
-        assert s["geom_continuous_angle_deg"] >= params.targets.continuous_angle_deg
+        assert s["geom_phi_S6_deg"] == pytest.approx(model, abs=CONTINUOUS_TOL_DEG)
+        assert s["geom_phi_S6_deg"] >= params.targets.continuous_drive_deg
         assert s["max_power_curve_deviation_mm"] <= TOWING_CURVE_TOL_MM
 
 

@@ -19,8 +19,8 @@ TEMPLATE = "nose_wheel_steering"
 # The failing verdicts below are decided by the exact model, so a coarse grid does not change
 # them (the grid only sets the mesh curve's sampling).
 COARSE = {"towing_step_deg": 1.0, "power_step_deg": 1.0}
-SHORT_TOP = ["pinion.topped_radius_mm=82.9", "targets.continuous_angle_deg=61"]
-HANDOVER_GAP = ["trim.hS2_mm=24.1", "trim.hS6_mm=24.6", "targets.continuous_angle_deg=60.5"]
+SHORT_TOP = ["pinion.topped_radius_mm=82.9", "targets.continuous_drive_deg=61"]
+HANDOVER_GAP = ["trim.hS2_mm=24.1", "trim.hS6_mm=24.6", "targets.continuous_drive_deg=60.5"]
 
 
 def _design(templates_dir, overrides=()):
@@ -77,7 +77,7 @@ def test_template_passes_every_verdict(templates_dir, tmp_path):
     assert all(v == 1 for v in s["verdicts"].values())
     assert {"continuous_drive", "contact_ratio"} <= set(s["verdicts"])
     assert s["continuous_drive_deg"] == pytest.approx(62.327, abs=1e-3)
-    assert s["model_continuous_towing_deg"] == pytest.approx(62.662, abs=1e-3)
+    assert s["model_towing_drive_deg"] == pytest.approx(62.662, abs=1e-3)
     assert s["model_contact_ratio"] == pytest.approx(1.2011, abs=1e-4)
 
 
@@ -128,7 +128,7 @@ def test_stop_is_named_by_the_corner_that_decides_it(templates_dir):
 
 @pytest.mark.parametrize("overrides", [
     ["pinion.topped_radius_mm=84.0"], ["trim.hS6_mm=25.4"], ["layout.centre_to_datum_mm=107.2"],
-    ["trim.min_contact_ratio=1.25"], ["targets.continuous_angle_deg=61"],
+    ["trim.min_contact_ratio=1.25"], ["targets.continuous_drive_deg=61"],
 ])
 def test_paper_values_only_beside_the_paper_design(templates_dir, overrides):
     paper = gearcheck.load(templates_dir / f"{TEMPLATE}.toml").calc()
@@ -224,7 +224,7 @@ def test_g2_corner_deciding_the_stop_is_named(templates_dir, tmp_path):
     assert not any("G1's tip land" in t for t in texts)
     assert all("G2's tip land over S4" in w.label for w in run.result.worst_poses) and run.result.worst_poses
     calc = _design(templates_dir, ["pinion.topped_radius_mm=82.3"]).calc()
-    graze = next(f for f in calc.figures if f.key == "towing_grazing_span_deg")
+    graze = next(f for f in calc.figures if f.key == "grazing_span_deg")
     assert graze.label.startswith("G2's tip land grazes S4") and "RS1 circle" not in graze.note
     _no_missing_value(run)
 
@@ -244,5 +244,5 @@ def test_a_swing_short_of_the_target_leaves_the_rest_to_the_model(templates_dir,
     assert "≥ 50.000° (not within the sweep)" in v.measured and "exact model alone" in v.evidence
     s = run.summary["steering"]
     assert s["geom_power_drive_deg"] == pytest.approx(62.327, abs=2e-3)  # the stroke went past S6
-    assert s["geom_continuous_angle_deg"] == pytest.approx(62.33, abs=0.05)
+    assert s["geom_phi_S6_deg"] == pytest.approx(62.33, abs=0.05)
     _no_missing_value(run)

@@ -182,7 +182,7 @@ def test_template_sweep_verdicts_and_figures(template_run):
     # no interference anywhere; the seated sleeve's clearance ri − R is resolved beyond the bound
     assert s["collisions"] == 0 and not any(r["collide"] for r in result.rows)
     assert s["min_tooth_sleeve_clearance_mm"] > bound
-    assert s["seated_sleeve_clearance_mm"] == pytest.approx(s["model_seating_clearance_mm"], abs=bound)
+    assert s["seated_sleeve_clearance_mm"] == pytest.approx(s["model_seated_sleeve_clearance_mm"], abs=bound)
     # the seated gap is the template's 0.75 mm (mesh: a plane against exact tip-corner vertices)
     assert s["seated_tip_gap_mm"] == pytest.approx(0.75, abs=bound)
     assert s["seated_tip_gap_max_mm"] == pytest.approx(0.75, abs=bound)

@@ -216,7 +216,7 @@ def test_template_passes_with_the_wear_verdict_and_figures(build_bodies):
     assert result.passed, [v for v in result.verdicts if not v.passed]
     assert verdicts["chain_wear_within_limit"].passed
     s = result.summary
-    assert s["wear_declared_pct"] == 1.5
+    assert s["wear_elongation_pct"] == 1.5
     assert s["wear_limit_pct"] == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
     assert wear.MODES[s["wear_limit_mode"]] == "tip" and s["wear"]["limit_mode_tip"] == 1
     assert s["wear"]["declared_seats"] == 1 and s["wear"]["declared_sweep_clear"] == 1
@@ -238,7 +238,7 @@ def test_declared_wear_above_the_limit_fails_with_exit_1(template, tmp_path):
     s = json.loads((out / "summary.json").read_text())["track"]
     assert s["verdicts"]["chain_wear_within_limit"] == 0
     assert all(v == 1 for k, v in s["verdicts"].items() if k != "chain_wear_within_limit")
-    assert s["wear_declared_pct"] == 2.0
+    assert s["wear_elongation_pct"] == 2.0
     assert s["wear_limit_pct"] == pytest.approx(WEAR_LIMIT_PCT, abs=WEAR_LIMIT_TOL_PCT)
     assert s["wear"]["declared_seats"] == 0
     line = next(ln for ln in proc.stdout.splitlines() if "declared chain wear" in ln)  # one line, the shortfall

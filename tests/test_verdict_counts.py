@@ -37,7 +37,7 @@ def test_the_target_verdict_from_the_sweep_data(template_check):
     v = next(v for v in run.verdicts if v.name == "cold_backlash_target")
     geom, exact = v.figures["geom_cold_backlash_total_min_arcmin"], v.figures["exact_cold_backlash_total_min_arcmin"]
     cold = next(v for v in run.verdicts if v.name == "cold_play_positive").figures
-    assert geom == 2 * cold["geom_cold_play_min_arcmin"] and exact == 2 * cold["exact_cold_play_min_arcmin"]
+    assert geom == 2 * cold["geom_play_min_arcmin_at_cold"] and exact == 2 * cold["exact_play_min_arcmin_at_cold"]
     assert v.level == "warn" and min(geom, exact) < 10.0 and "short by" in v.shortfall
     summary = json.loads((run.folder / "summary.json").read_text())["differential"]
     assert summary["verdict_levels"]["cold_backlash_target"] == "warn"

@@ -245,7 +245,8 @@ class MechanismContract:
     - calc and the assembly run with neither the CAD kernel, FCL nor matplotlib imported;
     - the assembly's poses are rigid transforms, its motions typed, its solids specified;
     - the plan's tasks pickle and run in a fresh process without CadQuery, with the same result;
-    - the check's verdicts have unique names and valid levels, and the report renders them.
+    - the check's verdicts have unique names and valid levels, and the report renders them;
+    - a ``model_<key>`` figure in summary.json is calc's ``<key>`` (one name per concept).
 
     The CAD-building tests carry the ``cad`` mark. ``tol_mm`` sets the meshing tolerance of the
     build the last two use (None: the mechanism's rule)."""
@@ -288,6 +289,13 @@ class MechanismContract:
         from gearcheck import pipeline
 
         return pipeline.build(design, tmp_path_factory.mktemp(design.mechanism), tol_mm=cls.tol_mm)
+
+    @pytest.fixture(scope="class")
+    @classmethod
+    def swept(cls, impl: Mechanism, design: Design, built: Any) -> Any:
+        from gearcheck import pipeline
+
+        return pipeline.sweep(design, built.assembly, built.bodies, jobs=1, options=impl.fuzz_options(design.params))
 
     # -- numpy only ---------------------------------------------------------------------------
     def test_analyse_gives_finite_figures(self, impl: Mechanism, design: Design) -> None:
@@ -344,13 +352,11 @@ class MechanismContract:
         assert same_result(local, remote), "the task gave another result in a fresh process"
 
     @pytest.mark.cad
-    def test_check_gives_unique_verdicts_and_a_report(self, impl: Mechanism, design: Design, built: Any) -> None:
-        from gearcheck import pipeline
+    def test_check_gives_unique_verdicts_and_a_report(self, impl: Mechanism, design: Design, swept: Any) -> None:
         from gearcheck.report.files import summary_json, sweep_csv
         from gearcheck.report.html import render
 
-        result = pipeline.sweep(design, built.assembly, built.bodies, jobs=1,
-                                options=impl.fuzz_options(design.params))
+        result = swept
         names = [v.name for v in result.verdicts]
         assert names and len(set(names)) == len(names), f"verdict names repeat: {names}"
         assert all(v.level in LEVELS and v.label and v.measured for v in result.verdicts)
@@ -360,3 +366,17 @@ class MechanismContract:
         page = render(result, title="t", template=design.source, build={})
         missing = [v.name for v in result.verdicts if html.escape(v.label) not in page]
         assert not missing, f"verdicts not in the report: {missing}"
+
+    @pytest.mark.cad
+    def test_summary_names_the_calc_figures(self, impl: Mechanism, design: Design, swept: Any) -> None:
+        """One name per concept: a ``model_<key>`` figure in summary.json is calc's ``<key>``, the
+        same number (the other prefixes name other evidence of the same concept: ``geom_`` the
+        meshes, ``exact_`` the exact geometry, ``paper_`` the printed figure)."""
+        calc = {f.key: f.value for f in design.calc().figures}
+        section = swept.summary.get(impl.section, swept.summary)
+        model = {k: v for k, v in section.items() if k.startswith("model_") and isinstance(v, (int, float))}
+        unnamed = sorted(k for k in model if k.removeprefix("model_") not in calc)
+        assert not unnamed, f"summary.json figures with no calc figure of that name: {unnamed}"
+        for key, value in model.items():
+            mine = calc[key.removeprefix("model_")]
+            assert math.isclose(value, mine, rel_tol=1e-6, abs_tol=1e-9), f"{key} = {value}, calc says {mine}"

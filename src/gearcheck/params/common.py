@@ -17,10 +17,10 @@ import tomllib
 import types
 import typing
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any, ClassVar, NoReturn
 
 import annotated_types as at
-from pydantic import BaseModel, ConfigDict, ValidationError
+from pydantic import BaseModel, ConfigDict, ValidationError, model_validator
 
 # re-exported: the mechanisms' validators import the range helpers from here
 from gearcheck.params.bounds import bisect_boundary, fmt_bound, fmt_range  # noqa: F401
@@ -88,6 +88,27 @@ class Section(BaseModel):
     """Base of every template section: unknown keys, NaN/inf and silent coercion are errors."""
 
     model_config = ConfigDict(extra="forbid", frozen=True, strict=True, allow_inf_nan=False)
+
+    #: keys a section once had, under their present names (old → new): a template written before a
+    #: rename still loads, with a warning naming the new key; both at once is an error
+    renamed: ClassVar[dict[str, str]] = {}
+
+    @model_validator(mode="before")
+    @classmethod
+    def _renamed_keys(cls, data: Any) -> Any:
+        if not cls.renamed or not isinstance(data, dict):
+            return data
+        data = dict(data)
+        for old, new in cls.renamed.items():
+            if old in data:
+                if new in data:
+                    raise ValueError(f"{old} is the old name of {new}: give {new} only")
+                import logging
+
+                logging.getLogger("gearcheck").warning("%s is now called %s: the template still loads; "
+                                                       "rename it to silence this", old, new)
+                data[new] = data.pop(old)
+        return data
 
 
 def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:

@@ -186,7 +186,9 @@ def calc(params: Params) -> list[Figure]:
                      else "")),
         Figure("cold_backlash_total_max_arcmin", f"cold total at {op.cold_C:g} °C, largest",
                design.cold_total_max_arcmin, "arcmin", digits=2),
-        Figure("cold_backlash_per_side_min_arcmin", f"cold per side at {op.cold_C:g} °C, least",
+        Figure("play_min_arcmin_at_warm", f"least play per side, warm at {op.warm_C:g} °C",
+               warm_min / 2.0, "arcmin", digits=2),
+        Figure("play_min_arcmin_at_cold", f"least play per side, cold at {op.cold_C:g} °C",
                design.cold_total_min_arcmin / 2.0, "arcmin", digits=2),
         Figure("cold_backlash_positive", f"{linear}: cold total > 0 at {op.cold_C:g} °C (1 yes, 0 no)",
                1.0 if cold_ok else 0.0, "pass", digits=0,
@@ -287,7 +289,7 @@ def _exact_figures(params: Params, exact: RangeCheck | None) -> list[Figure]:
         return figs
     shim = params.shim.thickness_mm
     for name in ("warm", "cold", "operating_min", "operating_max", "storage_min", "storage_max"):
-        figs.append(Figure(f"exact_play_per_side_min_arcmin_at_{name}",
+        figs.append(Figure(f"exact_play_min_arcmin_at_{name}",
                            f"exact least play per side, {STATE_TEXT[name]} {exact.keys[name]:g} °C",
                            exact.at(name), "arcmin", digits=3, note=f"shim {_mm(shim)} mm, exact flanks"))
     (op_least, op_at), (st_least, st_at) = exact.operating, exact.storage

@@ -333,7 +333,7 @@ def notes(params, data: SweepData, summary: dict) -> list[str]:
         f"Cold drop per side at shim {shim_text(shims[t])} mm: geometry {sm['geom_cold_drop_per_side_arcmin']:.2f}′, "
         f"exact flanks {sm['exact_cold_drop_per_side_arcmin']:.2f}′, "
         f"paper's model {sm['model_cold_drop_per_side_arcmin']:.2f}′ "
-        f"(clean eq 9: {sm['clean_model_cold_drop_per_side_arcmin']:.2f}′). Eqs (1)–(11) look at one tooth pair at the "
+        f"(clean eq 9: {sm['model_clean_cold_drop_per_side_arcmin']:.2f}′). Eqs (1)–(11) look at one tooth pair at the "
         "outer pitch point; the cold state slides each gear's apex off the common apex, so the mesh is no longer "
         "conjugate and neighbouring tooth pairs close up (docs/differential.md). Reported, not tuned.",
         "Where the play is decided: a translation changes the flank gap by the same amount in mm along the whole "

@@ -83,8 +83,8 @@ def _warm(data: SweepData, resolves: bool) -> Verdict:
         f"contact reached both ways at every pose; least warm play {geom_min[t, w]:.3f}′ per side "
         f"({BIG_GEARS[least[1]]}, drive {math.degrees(angles[least[0]]):.2f}°), exact {exact_min[t, w]:.3f}′, "
         f"mesh bound ±{2 * data.bound_arcmin:.2f}′ on a play",
-        {"centred_poses_free": float(warm_free), "geom_warm_play_min_arcmin": float(geom_min[t, w]),
-         "exact_warm_play_min_arcmin": float(exact_min[t, w])},
+        {"centred_poses_free": float(warm_free), "geom_play_min_arcmin_at_warm": float(geom_min[t, w]),
+         "exact_play_min_arcmin_at_warm": float(exact_min[t, w])},
         evidence=_play_evidence(data, resolves, f"{data.states[w][1]:g} °C"),
         shortfall=_play_shortfall("least warm play", float(geom_min[t, w]), float(exact_min[t, w]), warm_free))
 
@@ -104,8 +104,8 @@ def _cold(data: SweepData, resolves: bool) -> Verdict:
         f"centred cold poses {'all free' if centred_free else 'COLLIDE'}; worst-case mesh bound "
         f"±{2 * data.bound_arcmin:.2f}′ on a play (the mesh matches the exact flanks to "
         f"{np.nanmax(data.total_dev[t, c]):.3f}′ here)",
-        {"centred_poses_free": float(centred_free), "geom_cold_play_min_arcmin": float(geom_min[t, c]),
-         "exact_cold_play_min_arcmin": float(exact_min[t, c])},
+        {"centred_poses_free": float(centred_free), "geom_play_min_arcmin_at_cold": float(geom_min[t, c]),
+         "exact_play_min_arcmin_at_cold": float(exact_min[t, c])},
         evidence=_play_evidence(data, resolves, f"{data.states[c][1]:g} °C"),
         shortfall=_play_shortfall(f"least cold play at {data.states[c][1]:g} °C", float(geom_min[t, c]),
                                   float(exact_min[t, c]), centred_free))

@@ -78,7 +78,7 @@ PAPER_DESIGN = {
     "rack": {"first_tooth": -7, "last_tooth": 7, "addendum_coefficient": 1.0, "dedendum_coefficient": 1.25},
     "layout": {"centre_to_datum_mm": 107.0},
     "trim": {"min_contact_ratio": 1.2, "hS2_mm": 25.13, "hS4_mm": 25.13, "hS6_mm": 25.51, "hS8_mm": 25.51},
-    "targets": {"continuous_angle_deg": 60.0},
+    "targets": {"continuous_drive_deg": 60.0},
 }
 
 

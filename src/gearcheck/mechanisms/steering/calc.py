@@ -27,7 +27,7 @@ def calc(params: Params) -> list[Figure]:
     tan_a = math.tan(g.pressure_angle_rad)
 
     # --- trimming design chain (solved) and the machined travels ---------------------------
-    design = an.solve_trims(g, params.trim.min_contact_ratio, math.radians(params.targets.continuous_angle_deg))
+    design = an.solve_trims(g, params.trim.min_contact_ratio, math.radians(params.targets.continuous_drive_deg))
     travel_s3s4 = an.travel_corner_on_circle(g, first_k + 1, g.hS4_mm, g.tip_radius)
     travel_s1s2 = an.travel_corner_on_circle(g, first_k, g.hS2_mm, rs1)
 
@@ -46,7 +46,8 @@ def calc(params: Params) -> list[Figure]:
     phi_s1 = an.phi_towing_conjugate_end(g, first_j)
     phi_s6 = an.phi_power_conjugate_end(g, first_k, g.hS6_mm)
     phi_s6_paper = an.phi_power_conjugate_end(g, first_k, hs6_half)
-    drive = min(whole_drive(g), key=lambda d: d.angle_rad)  # towing and power, every hand-over
+    towing_drive, power_drive = whole_drive(g)
+    drive = min(towing_drive, power_drive, key=lambda d: d.angle_rad)  # towing and power, every hand-over
     continuous = drive.angle_rad
 
     # --- towing push model -----------------------------------------------------------------
@@ -118,11 +119,13 @@ def calc(params: Params) -> list[Figure]:
         F("alpha_S6_deg", "pressure angle at S6, αS6 (eq 18)", _deg(an.pressure_angle_at_power_corner(g, g.hS6_mm)),
           "deg", paper=P["alpha_S6_deg"],
           note=f"{_deg(an.pressure_angle_at_power_corner(g, hs6_half)):.2f} at the paper's-lines hS6"),
-        F("continuous_angle_deg", "continuous drive to (towing and power, every hand-over)", _deg(continuous), "deg",
+        F("continuous_drive_deg", "continuous drive to (towing and power, every hand-over)", _deg(continuous), "deg",
           paper=P["phi_S6_deg"],
           note=f"{drive.event}; ADAMS 62-63°, test {P['test_continuous_deg']:g}° (backlash, deflection)"),
-        F("continuous_margin_deg", "continuous drive beyond targets.continuous_angle_deg",
-          _deg(continuous) - params.targets.continuous_angle_deg, "deg",
+        F("towing_drive_deg", "towing: continuous drive to (every hand-over)", towing_drive.angle_deg, "deg"),
+        F("power_drive_deg", "power: continuous drive to (every hand-over)", power_drive.angle_deg, "deg"),
+        F("continuous_margin_deg", "continuous drive beyond targets.continuous_drive_deg",
+          _deg(continuous) - params.targets.continuous_drive_deg, "deg",
           note="≥ 0: power-steering requirement met"),
         # towing push model
         F("disengage_angle_deg", "towing: rack stops for good (full disengage)", dis_deg, "deg",
@@ -135,7 +138,7 @@ def calc(params: Params) -> list[Figure]:
           paper=P["travel_disengage_mm"],
           note=beyond or f"S1 rounded: RS1 84.298 gives 110.20; ADAMS {P['adams_travel_mm']:g}, "
                          f"test {P['test_travel_mm']:g}"),
-        F("towing_grazing_span_deg", f"{stop_phrase(g, tow.last_pusher)} at zero clearance for"
+        F("grazing_span_deg", f"{stop_phrase(g, tow.last_pusher)} at zero clearance for"
           if tow.last_pusher else "tip land grazes the stop corner at zero clearance for",
           _deg(tow.grazing_end_rad - tow.disengage_rad), "deg",
           note=beyond or ("S2 lies on the RS1 circle by design" if tow.last_pusher == (first_j, first_k)
@@ -161,14 +164,14 @@ def calc(params: Params) -> list[Figure]:
     if an.is_paper_design(params):
         return _without_missing(figures, params, tow)
     # another design: no printed targets, no notes about the paper's figures, no sample at ADAMS's angle
-    keep = {"contact_ratio", "continuous_margin_deg", "towing_max_overlap_mm", "towing_grazing_span_deg",
+    keep = {"contact_ratio", "continuous_margin_deg", "towing_max_overlap_mm", "grazing_span_deg",
             "travel_S3S4_solved_mm", "reengage_angle_deg"}
     out = []
     for f in figures:
         if f.key == "towing_travel_mm_at_adams_angle":
             continue
         note = f.note
-        if f.key == "continuous_angle_deg":
+        if f.key == "continuous_drive_deg":
             note = drive.event
         elif f.key not in keep and note != beyond:
             note = ""
@@ -181,7 +184,7 @@ def calc(params: Params) -> list[Figure]:
 # travel at the end of the swing, which always has one).
 TRIM_KEYS = ("RS1_solved_mm", "hS2_solved_mm")
 TOWING_KEYS = ("disengage_angle_deg", "disengage_angle_paper_bookkeeping_deg", "rack_travel_at_disengage_mm",
-               "towing_grazing_span_deg", "reengage_angle_deg", "towing_travel_mm_at_068deg",
+               "grazing_span_deg", "reengage_angle_deg", "towing_travel_mm_at_068deg",
                "towing_travel_mm_at_072deg", "towing_travel_mm_at_075deg", "towing_travel_mm_at_adams_angle")
 
 
@@ -197,7 +200,7 @@ def _why_missing(key: str, params: Params, tow) -> str:
         return why[key]
     if math.isnan(tow.disengage_rad):
         return f"the rack is still moving at towing.max_angle_deg = {max_deg:g}°"
-    if key == "towing_grazing_span_deg":
+    if key == "grazing_span_deg":
         return "the tip land still touches the stop corner at the end of the swing"
     return "the model has no value for this design"
 

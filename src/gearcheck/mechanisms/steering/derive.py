@@ -49,7 +49,7 @@ DEFAULTS: dict[str, float] = {
     "rack.addendum_coefficient": 1.0,
     "rack.dedendum_coefficient": 1.25,
     "trim.min_contact_ratio": 1.2,
-    "targets.continuous_angle_deg": 60.0,
+    "targets.continuous_drive_deg": 60.0,
     "towing.max_angle_deg": 100.0,
 }
 # Values the chain derives; given with --set, each is an input to the steps after it.
@@ -192,7 +192,7 @@ def _chain(base: Mapping[str, Any], given: Mapping[str, Any], n: int) -> _Chain:
 
 def _indexing(v: dict[str, Any], notes: dict[str, str], given: Mapping[str, Any], n: int) -> None:
     """Step 3: the rack and sector tooth indices for the stroke."""
-    z, target = v["pinion.teeth"], v["targets.continuous_angle_deg"]
+    z, target = v["pinion.teeth"], v["targets.continuous_drive_deg"]
     tau = 360.0 / z
     first = int(given.get("rack.first_tooth", -n))
     v["rack.first_tooth"] = first
@@ -256,11 +256,11 @@ def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str]
     g = an.with_inputs(g, hS4_mm=hs4)
     rs1 = _given(given, notes, "pinion.topped_radius_mm", "RS1 as given")
     if rs1 is None:
-        aim = v["targets.continuous_angle_deg"] + DRIVE_MARGIN_DEG
+        aim = v["targets.continuous_drive_deg"] + DRIVE_MARGIN_DEG
         rs1 = topped_radius_for_angle(g, aim)
         if math.isnan(rs1):
             raise NoDesign(f"G1 at the full tip radius {g.tip_radius:g} mm lets go of S1 before {aim:g}°",
-                           "targets.continuous_angle_deg")
+                           "targets.continuous_drive_deg")
         notes["pinion.topped_radius_mm"] = (f"RS1: G1's contact reaches S1 at {aim:g}° (target + "
                                             f"{DRIVE_MARGIN_DEG:g}°, eq 17 solved), rounded up")
     g = an.with_inputs(g, topped_radius_mm=rs1)
@@ -328,12 +328,12 @@ def _verify(chain: _Chain) -> None:
     except Exception as exc:  # pydantic's field ranges
         raise NoDesign(f"a derived value is out of range: {str(exc).splitlines()[0]}") from None
     g = an.geometry_from_params(params)
-    target = params.targets.continuous_angle_deg
+    target = params.targets.continuous_drive_deg
     drive = min(whole_drive(g), key=lambda d: d.angle_rad)
     chain.drive_deg, chain.drive_event = math.degrees(drive.angle_rad), drive.event
     if chain.drive_deg < target:
         raise NoDesign(f"the continuous drive ends at {chain.drive_deg:.3f}° < target {target:g}° ({drive.event})",
-                       "targets.continuous_angle_deg")
+                       "targets.continuous_drive_deg")
     eps = an.contact_ratio(g, g.hS4_mm)
     if eps < params.trim.min_contact_ratio:
         raise NoDesign(f"ε = {eps:.4f} at hS4 < trim.min_contact_ratio = {params.trim.min_contact_ratio:g}")
@@ -371,7 +371,7 @@ def new(inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
     for key in DERIVED:
         if key in overrides:
             given[key] = _number(overrides, key)
-    target = base["targets.continuous_angle_deg"]
+    target = base["targets.continuous_drive_deg"]
     n = teeth_to_target(z, target)
     tries = [-int(given["rack.first_tooth"])] if "rack.first_tooth" in given else [n, n + 1]
     failures: list[NoDesign] = []
@@ -412,7 +412,7 @@ SECTION_ORDER = {
     "rack": ("first_tooth", "last_tooth", "addendum_coefficient", "dedendum_coefficient"),
     "layout": ("centre_to_datum_mm",),
     "trim": ("min_contact_ratio", "hS2_mm", "hS4_mm", "hS6_mm", "hS8_mm"),
-    "targets": ("continuous_angle_deg",),
+    "targets": ("continuous_drive_deg",),
     "towing": ("max_angle_deg",),
 }
 INPUT_NOTES = {
@@ -425,7 +425,7 @@ INPUT_NOTES = {
     "rack.addendum_coefficient": "rack top above its reference line, in modules",
     "rack.dedendum_coefficient": "rack root below its reference line, in modules",
     "trim.min_contact_ratio": "design rule that sets hS4",
-    "targets.continuous_angle_deg": "power steering drives continuously to at least this angle",
+    "targets.continuous_drive_deg": "power steering drives continuously to at least this angle",
     "towing.max_angle_deg": "towing swing either way",
 }
 

@@ -84,7 +84,9 @@ class Trim(Section):
 
 
 class Targets(Section):
-    continuous_angle_deg: float = Field(gt=0, lt=180,
+    renamed = {"continuous_angle_deg": "continuous_drive_deg"}
+
+    continuous_drive_deg: float = Field(gt=0, lt=180,
         description="Power-steering requirement: continuous drive to at least this pinion angle", json_schema_extra=DEG)
 
 

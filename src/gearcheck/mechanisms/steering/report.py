@@ -65,7 +65,7 @@ def _rows(P: dict, data: SteeringSweep) -> list[Comparison]:
     dis, stand = plus["geom_disengage_angle_deg"], plus["geom_rack_travel_at_disengage_mm"]
     if still_moving(plus, model.moving_at_end, data.tol):  # no stop: the 'disengage' is the swing's end
         dis = stand = math.nan
-    cont = plus["geom_continuous_angle_deg"]
+    cont = plus["geom_phi_S6_deg"]
     return [
         Comparison("disengage angle (rack stops), theory", "deg", P["disengage_deg"], model.disengage_deg, dis,
                    "paper adds −(hS2 − h)·tanα/r to the angle (75.33 with it)"),
@@ -147,7 +147,7 @@ def _plots(P: dict, data: SteeringSweep) -> list[Plot]:
              [Series(f"{sign(d)} direction", list(np.abs(np.degrees(power[d]["angles"]))), list(power[d]["offsets"]),
                      "points")
               for d in (1, -1)],
-             markers=[("mesh limit", plus["geom_continuous_angle_deg"]), ("model", model.power_limit_deg),
+             markers=[("mesh limit", plus["geom_phi_S6_deg"]), ("model", model.power_limit_deg),
                       ("paper theory", P["phi_S6_deg"]), ("test", P["test_continuous_deg"]),
                       ("raw FCL corner contact", plus["geom_raw_corner_contact_angle_deg"])],
              hlines=[("S6", 0.0)]),
@@ -182,8 +182,8 @@ def _notes(P: dict, data: SteeringSweep) -> list[str]:
         f"The return swing picks the rack up at {plus['geom_reengage_angle_deg']:.3f}° "
         f"(model {model.reengage_deg:.3f}°).",
         _handover_note(data),
-        f"Power mode: the contact reaches S6 at {plus['geom_continuous_angle_deg']:.3f}° / "
-        f"{minus['geom_continuous_angle_deg']:.3f}° (model {model.power_limit_deg:.3f}°). The raw FCL nearest point "
+        f"Power mode: the contact reaches S6 at {plus['geom_phi_S6_deg']:.3f}° / "
+        f"{minus['geom_phi_S6_deg']:.3f}° (model {model.power_limit_deg:.3f}°). The raw FCL nearest point "
         f"reaches the corner at {plus['geom_raw_corner_contact_angle_deg']:.2f}° / "
         f"{minus['geom_raw_corner_contact_angle_deg']:.2f}°: a polygonal flank's vertex/chord ambiguity, which the "
         "tangency estimate removes.",

@@ -43,5 +43,5 @@ def sample(data: dict, draw: Draw) -> None:
     # form radius; a miss there is a rejection, which is fine).
     lo = H - trim["hS2_mm"]
     pin["topped_radius_mm"] = round(lo + (tip - lo) * _knob(draw, 0.05, 1.0, 4), 4)
-    data["targets"]["continuous_angle_deg"] = _knob(draw, 10.0, 90.0, 2)
+    data["targets"]["continuous_drive_deg"] = _knob(draw, 10.0, 90.0, 2)
     data["towing"]["max_angle_deg"] = _knob(draw, 30.0, 120.0, 2)

@@ -293,7 +293,7 @@ def _direction_summary(r: dict, p: dict, towing_dev: float, power_dev: float, to
         # the pinion reaching the rack held one contact tolerance short of its stand)
         "geom_disengage_bracket_at_tol_deg": [abs(deg(a)) for a in r["disengage_bracket"] or (math.nan, math.nan)],
         "geom_reengage_bracket_deg": [abs(deg(a)) for a in r["reengage_bracket"] or (math.nan, math.nan)],
-        "geom_continuous_angle_deg": abs(deg(p["limit_angle"])),
+        "geom_phi_S6_deg": abs(deg(p["limit_angle"])),
         "geom_rack_travel_at_continuous_limit_mm": abs(p["limit_travel"]),
         "geom_raw_corner_contact_angle_deg": abs(deg(p["raw_corner_angle"])),
         "geom_towing_conjugate_end_deg": deg(towing_end),
@@ -391,7 +391,7 @@ def drive_figures(model: ModelFigures, plus: dict, minus: dict, drives: dict, to
             drive = drives[(mode, d)]
             (bounds if drive.bounded else limits).append(
                 (drive.angle_deg, f"mesh sweep, {sign(d)} direction, {drive.event}"))
-        s6, stroke = s["geom_continuous_angle_deg"], s["geom_power_stroke_end_deg"]
+        s6, stroke = s["geom_phi_S6_deg"], s["geom_power_stroke_end_deg"]
         if math.isfinite(s6):
             limits.append((s6, f"mesh sweep, {sign(d)} direction: power-mode contact reaches S6 (tangency)"))
         else:
@@ -469,14 +469,14 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "paper_test_rack_travel_mm": P["test_travel_mm"],
         "model_grazing_span_deg": model.graze_deg,
         "model_reengage_angle_deg": model.reengage_deg,
-        "model_continuous_angle_deg": model.continuous_deg,
-        "model_continuous_towing_deg": model.towing_drive_deg,
-        "model_continuous_power_deg": model.power_drive_deg,
+        "model_continuous_drive_deg": min(model.towing_drive_deg, model.power_drive_deg),
+        "model_towing_drive_deg": model.towing_drive_deg,
+        "model_power_drive_deg": model.power_drive_deg,
         "continuous_drive_deg": _least(*(f[0] for f in model_c + limits)),
-        "mesh_continuous_drive_deg": _least(*(f[0] for f in limits)),
+        "geom_continuous_drive_deg": _least(*(f[0] for f in limits)),
         "model_contact_ratio": model.contact_ratio,
-        "paper_continuous_angle_deg": P["phi_S6_deg"],
-        "paper_test_continuous_angle_deg": P["test_continuous_deg"],
+        "paper_phi_S6_deg": P["phi_S6_deg"],
+        "paper_test_continuous_drive_deg": P["test_continuous_deg"],
         "max_towing_curve_deviation_mm": max(towing_dev.values()),
         "min_signed_clearance_mm": min(plus["min_signed_clearance_mm"], minus["min_signed_clearance_mm"]),
         "contact_tolerance_mm": tol,

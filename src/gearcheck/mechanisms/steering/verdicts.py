@@ -33,7 +33,7 @@ def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
     def each(key):
         return [s[key] for s in (plus, minus)]
 
-    target, max_deg = params.targets.continuous_angle_deg, params.towing.max_angle_deg
+    target, max_deg = params.targets.continuous_drive_deg, params.towing.max_angle_deg
     ret, re = each("min_clearance_return_swing_mm"), each("geom_reengage_angle_deg")
     clear = each("min_signed_clearance_mm")
     bracket = plus["geom_reengage_bracket_deg"]
@@ -210,7 +210,7 @@ def _continuous_drive(data: SteeringSweep, target: float) -> Verdict:
                 + (f", ≥ {_num(bound_least)}° ({bound_event.split(', ', 1)[-1]})" if beyond else "")
                 + f" — exact model: towing {_num(model.towing_drive_deg)}° / power {_num(model.power_drive_deg)}°; "
                 f"mesh sweep (contact intervals): towing {both('towing')}, power {both('power')}; power contact "
-                f"reaches S6 at {_reach(plus, minus, 'geom_continuous_angle_deg', 'geom_power_stroke_end_deg')}; "
+                f"reaches S6 at {_reach(plus, minus, 'geom_phi_S6_deg', 'geom_power_stroke_end_deg')}; "
                 f"towed rack falls {tol:.3f} mm behind r·φ at "
                 f"{_reach(plus, minus, 'geom_towing_conjugate_end_deg', 'geom_towing_swing_end_deg')}")
     decides = "exact model" if event.startswith("exact model") else "mesh sweep"
@@ -225,14 +225,14 @@ def _continuous_drive(data: SteeringSweep, target: float) -> Verdict:
                "mesh_towing_minus_deg": data.drive("towing", -1).angle_deg,
                "mesh_power_plus_deg": data.drive("power", 1).angle_deg,
                "mesh_power_minus_deg": data.drive("power", -1).angle_deg,
-               "plus_deg": plus["geom_continuous_angle_deg"], "minus_deg": minus["geom_continuous_angle_deg"],
+               "plus_deg": plus["geom_phi_S6_deg"], "minus_deg": minus["geom_phi_S6_deg"],
                "geom_towing_plus_deg": plus["geom_towing_conjugate_end_deg"],
                "geom_towing_minus_deg": minus["geom_towing_conjugate_end_deg"]}
     short = (f"continuous drive {_num(least)}° ({event.split(', ', 1)[-1]}), required ≥ {target:g}°"
              + (f", short by {target - least:.3f}°" if math.isfinite(least) else ""))
     return Verdict.of(
         "continuous_drive",
-        f"continuous drive (towing and power mode, every hand-over) to ≥ {target:g}° (targets.continuous_angle_deg)",
+        f"continuous drive (towing and power mode, every hand-over) to ≥ {target:g}° (targets.continuous_drive_deg)",
         passed, measured, _finite(figures), evidence, shortfall=short)
 
 

@@ -144,6 +144,8 @@ def _geometry(params: Params, add):
     add("iso_seating_radius_min_mm", "ISO 606 seating radius ri min", lim.seating_radius_min_mm, "mm")
     add("iso_seating_radius_max_mm", "ISO 606 seating radius ri max", lim.seating_radius_max_mm, "mm")
     add("seating_radius_mm", "chosen seating radius ri (ρf)", sp.seating_radius_mm, "mm", "within ISO limits")
+    add("seated_sleeve_clearance_mm", "seated sleeve clearance ri − R", sp.seating_radius_mm
+        - params.chain.sleeve_diameter_mm / 2.0, "mm", "sleeve centred on its seating arc", 4)
     add("iso_flank_radius_min_mm", "ISO 606 flank radius re min", lim.flank_radius_min_mm, "mm", digits=2)
     add("iso_flank_radius_max_mm", "ISO 606 flank radius re max", lim.flank_radius_max_mm, "mm", digits=2)
     add("flank_radius_mm", "chosen flank radius re", sp.flank_radius_mm, "mm", "within ISO limits", 2)

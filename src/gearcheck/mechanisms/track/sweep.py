@@ -423,7 +423,7 @@ def summary(d: TrackSweep) -> dict:
         "seated_sleeve_clearance_mm": x["seated_sleeve"].value,
         "min_tooth_sleeve_unseated_mm": finite(x["off_sleeve"].value),
         "min_tooth_sleeve_unseated_angle_deg": float(deg(angles[x["off_sleeve"].pose_index])),
-        "model_seating_clearance_mm": model.seating_clearance_mm,
+        "model_seated_sleeve_clearance_mm": model.seating_clearance_mm,
         "exact": {
             "min_tip_plate_distance_mm": x["ex_min_plate"].value,
             "seated_tip_gap_mm": x["ex_seated_gap"].value,
@@ -480,7 +480,7 @@ def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: f
     }
     return {
         "wear_limit_pct": 100.0 * w.limit,
-        "wear_declared_pct": 100.0 * w.declared,
+        "wear_elongation_pct": 100.0 * w.declared,
         "wear_limit_mode": w.mode_code,
         "wear": {
             "limit_pct": 100.0 * w.limit,

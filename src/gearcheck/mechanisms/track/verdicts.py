@@ -150,7 +150,7 @@ def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
         f"declared {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % ({MODE_TEXT[w.mode]}; "
         f"{w.bracket_text()}); at the declared wear the sleeve {seat}, {sweep} "
         f"(exact 2-D model){mesh}",
-        {"wear_declared_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
+        {"wear_elongation_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
          "wear_limit_mode": w.mode_code},
         evidence="exact model (2-D section: exact arcs, closed form or bisection on the elongation); mesh sweep at "
                  "the declared wear",
