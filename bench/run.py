@@ -18,7 +18,9 @@ baseline reports — and, beside it, over the sweep's whole wall time: the same 
 time, however many FCL queries the current code needs for it); steering poses/s and track
 sprocket poses/s over the sweep's wall time; the worker pool's speed-up from 1 to 2 workers (and
 to every core). Written to ``--out`` with the ratios (current / baseline) and each target's met
-flag; the study section (bench/study.py) measures the current code only.
+flag; the study section (bench/study.py) and the assembly section (bench/assembly.py: an assembly's
+sweep against the native mechanism's on the same poses, a 10⁶-triangle file) measure the current
+code only.
 
 Speed targets live here, never in timed tests.
 """
@@ -456,16 +458,28 @@ def table(targets: list[dict], cur: dict[str, Any], base: dict[str, Any], n_core
     return "\n".join(lines)
 
 
-def study_section() -> dict[str, Any]:
-    """bench/study.py on the current code, in this process."""
+def _section(module: str, function: str, label: str) -> dict[str, Any]:
+    """``bench/MODULE.py``'s FUNCTION on the current code, in this process; an error is recorded,
+    never a reason to lose the side-by-side figures."""
     sys.path[:0] = [str(ROOT / "src"), str(BENCH)]
     try:
-        from study import bench_study  # bench/study.py, beside this file
+        import importlib
 
-        return bench_study()
-    except Exception as exc:  # the side-by-side figures are written even when the study fails
-        log(f"study section failed: {type(exc).__name__}: {exc}")
+        return getattr(importlib.import_module(module), function)()
+    except Exception as exc:
+        log(f"{label} section failed: {type(exc).__name__}: {exc}")
         return {"error": f"{type(exc).__name__}: {exc}"}
+
+
+def study_section() -> dict[str, Any]:
+    """bench/study.py on the current code."""
+    return _section("study", "bench_study", "study")
+
+
+def assembly_section() -> dict[str, Any]:
+    """bench/assembly.py on the current code: an assembly's sweep against the native mechanism's on
+    the same poses, and a 10⁶-triangle file's time and peak memory."""
+    return _section("assembly", "bench_assembly", "assembly")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -510,10 +524,18 @@ def main(argv: list[str] | None = None) -> int:
     if not (args.quick or args.skip_study):
         log("study section (current code) ...")
         result["study"] = study_section()
+    if not args.quick:
+        log("assembly section (current code) ...")
+        result["assembly"] = assembly_section()
+        write_json(args.out, result)
     result["machine"]["loadavg_end"] = list(os.getloadavg())
     result["total_s"] = time.perf_counter() - t_start
     write_json(args.out, result)
     print(table(targets, cur, base, n_cores))
+    for name, fig in (result.get("assembly") or {}).items():
+        if isinstance(fig, dict) and "target" in fig:
+            print(f"assembly, {name.replace('_', ' ')}: {'met' if fig['met'] else 'NOT met'} ({fig['target']}): "
+                  + ", ".join(f"{k} {v:.4g}" for k, v in fig.items() if isinstance(v, float)))
     met = sum(t["met"] for t in targets)
     print(f"\n{met}/{len(targets)} targets met; baseline {args.baseline}, current {current.commit[:12]}"
           f"{' (dirty)' if current.dirty else ''}; medians of {repeat} run(s) each, {n_cores} cores, "

@@ -19,6 +19,7 @@ TEMPLATE_FILES = {
     "track": "eod_track_drive.toml",
     "steering": "nose_wheel_steering.toml",
     "roller_chain": "roller_chain_12B_z21.toml",
+    "assembly": "assembly_spur_pair.toml",
 }
 
 
@@ -135,11 +136,11 @@ def test_resolved_parameters_round_trip_through_toml(tmp_path, templates_dir, na
     from gearcheck.params.common import to_toml
 
     loaded = load_template(templates_dir / name)
-    copy = tmp_path / name
-    copy.write_text(to_toml(loaded.data))
+    copy = tmp_path / name  # another folder: a file the template names is recorded by its absolute path
+    copy.write_text(to_toml(loaded.resolved_data))
     again = load_template(copy)
     assert again.params == loaded.params
-    assert again.data == loaded.data
+    assert again.resolved_data == loaded.resolved_data
 
 
 def test_optional_name_must_be_a_folder_name(tmp_path, templates_dir):

@@ -19,6 +19,7 @@ import pytest
 
 from conftest import ROOT, TEMPLATES
 from gearcheck.cli import main
+from gearcheck.design import load_template
 from gearcheck.output import RUN_MARKER, OutputError, RunFolder
 from gearcheck.params import ParamError
 
@@ -236,7 +237,8 @@ def test_all_runs_the_shipped_templates_from_an_empty_folder(tmp_path):
     proc = subprocess.run([*GEARCHECK, "build", "--all", "--out", "o"], cwd=tmp_path, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     assert sorted(p.name for p in (tmp_path / "o").iterdir() if not p.name.startswith(".")) == [
-        "eod_track_drive", "nose_wheel_steering", "roller_chain_12B_z21", "zhurong_differential"]
+        "assembly_spur_pair", "eod_track_drive", "nose_wheel_steering", "roller_chain_12B_z21",
+        "zhurong_differential"]
     (tmp_path / "empty").mkdir()
     proc = subprocess.run([*GEARCHECK, "check", "--all", "--templates", "empty"], cwd=tmp_path, capture_output=True,
                           text=True)
@@ -249,10 +251,12 @@ def test_templates_are_listed_and_copied(tmp_path, capsys):
     assert "zhurong_differential.toml" in out and "differential" in out
     assert main(["templates", "--copy", str(tmp_path / "mine")]) == 0
     copied = sorted(p.name for p in (tmp_path / "mine").glob("*.toml"))
-    assert copied == ["eod_track_drive.toml", "nose_wheel_steering.toml", "roller_chain_12B_z21.toml",
-                      "zhurong_differential.toml"]
+    assert copied == ["assembly_spur_pair.toml", "eod_track_drive.toml", "nose_wheel_steering.toml",
+                      "roller_chain_12B_z21.toml", "zhurong_differential.toml"]
+    assert (tmp_path / "mine" / "assembly_spur_pair.step").is_file()  # the STEP it names, beside it
+    assert load_template(tmp_path / "mine" / "assembly_spur_pair.toml").mechanism == "assembly"
     assert sorted(p.name for p in (tmp_path / "mine" / "schema").iterdir()) == [
-        "differential.json", "roller_chain.json", "steering.json", "track.json"]
+        "assembly.json", "differential.json", "roller_chain.json", "steering.json", "track.json"]
     (tmp_path / "mine" / "eod_track_drive.toml").write_text("# my edits\n")
     assert main(["templates", "--copy", str(tmp_path / "mine")]) == 2  # never overwrites an edited copy
     assert (tmp_path / "mine" / "eod_track_drive.toml").read_text() == "# my edits\n"

@@ -141,18 +141,23 @@ def build_parser() -> argparse.ArgumentParser:
         "the derivation where it is one). The numbers each mechanism takes:\n"
         "  differential  --module M --teeth SMALL/BIG   (side gear / planet bevel gears)\n"
         "  steering      --module M --teeth Z           (pinion teeth)\n"
-        "  roller_chain  --chain 12B --teeth Z [--strands 1-3]   (ISO 606 A or B series)",
+        "  roller_chain  --chain 12B --teeth Z [--strands 1-3]   (ISO 606 A or B series)\n"
+        "  assembly      --step FILE.step   (your own CAD: its products listed as parts; you fill in the joints "
+        "and the motion)",
         epilog="Examples:\n  gearcheck new differential --module 3 --teeth 14/30 --out my_diff.toml\n"
                "  gearcheck new steering --module 5 --teeth 34 --out my_steering.toml\n"
                "  gearcheck new roller_chain --chain 16A --teeth 25 --strands 2 --out my_sprocket.toml\n"
                "  gearcheck new differential --module 2 --teeth 16/40 --set operating.cold_C=-120 --out d.toml\n"
+               "  gearcheck new assembly --step my_gearbox.step --out my_gearbox.toml\n"
                "  gearcheck check my_diff.toml",
     )
-    new.add_argument("mechanism", metavar="MECHANISM", help="differential, steering or roller_chain")
+    new.add_argument("mechanism", metavar="MECHANISM", help="differential, steering, roller_chain or assembly")
     new.add_argument("--module", default=None, metavar="M", help="gear module, mm")
     new.add_argument("--teeth", default=None, metavar="Z", help="tooth count(s): Z, or SMALL/BIG for a pair")
     new.add_argument("--chain", default=None, metavar="DESIGNATION", help="ISO 606 chain, e.g. 08B, 12B, 16A")
     new.add_argument("--strands", default=None, metavar="N", help="chain strands, 1 to 3 (default 1)")
+    new.add_argument("--step", default=None, metavar="FILE.step", help="assembly: the STEP file whose products "
+                     "are the parts")
     new.add_argument("--set", dest="overrides", action="append", default=[], metavar="SECTION.KEY=VALUE",
                      help="set any other template value (repeatable); an input of the derivation where it is one")
     new.add_argument("--out", type=Path, default=None, metavar="FILE.toml",

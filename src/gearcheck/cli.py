@@ -28,12 +28,22 @@ class Interrupted(BaseException):
 
 
 _received: list[int] = []
+_in_main: list[bool] = []  # main() is running: an interrupt unwinds through its cleanup
 
 
 def _on_signal(signum: int, _frame: object) -> None:
     if _received:  # already unwinding: let the cleanup finish
         return
     _received.append(signum)
+    if not _in_main:  # before main() runs (this module still importing, the console script's own lines)
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        try:  # the standard library's signal and sys only: nothing else is imported yet
+            sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(signum).name}): nothing written\n")
+            sys.stderr.flush()
+        except OSError:
+            pass
+        raise SystemExit(128 + signum)
     raise Interrupted(signum)
 
 
@@ -353,14 +363,17 @@ def cmd_templates(args) -> int:
         print(f"({len(studies)} studies; run one with `gearcheck study NAME`)")
         return 0
     folder = ensure_out_dir(args.copy, "--copy")
-    copies = [(p, folder / p.name) for p in shipped] + [(p, folder / SCHEMA_FOLDER / p.name) for p in schemas]
+    files = sorted(packaged_templates().glob("*.step"))  # the CAD an assembly template names, beside it
+    copies = [(p, folder / p.name) for p in [*shipped, *files]] + [(p, folder / SCHEMA_FOLDER / p.name)
+                                                                   for p in schemas]
     for path, target in copies:
         if target.exists() and target.read_bytes() != path.read_bytes():
             raise OutputError(target, "exists and differs from the shipped file (not overwritten)")
     for path, target in copies:
         target.parent.mkdir(exist_ok=True)
         shutil.copyfile(path, target)
-    print(f"copied {len(shipped)} templates to {folder}/ (their schemas to {folder / SCHEMA_FOLDER}/)")
+    print(f"copied {len(shipped)} templates to {folder}/ (the STEP files they name beside them, their schemas to "
+          f"{folder / SCHEMA_FOLDER}/)")
     return 0
 
 
@@ -384,16 +397,28 @@ def cmd_new(args) -> int:
     """Write a complete template from the numbers that define a design (gearcheck.new)."""
     from gearcheck.drafting import default_name, draft, new
 
-    inputs = {"module": args.module, "teeth": args.teeth, "chain": args.chain, "strands": args.strands}
+    inputs = {"module": args.module, "teeth": args.teeth, "chain": args.chain, "strands": args.strands,
+              "step": args.step}
     if args.out is not None and str(args.out) == "-":
         from gearcheck.design import from_data
 
         result = draft(args.mechanism, args.overrides, **inputs)
-        from_data(result.data())
+        if result.complete:
+            from_data(result.data())
+        result.relative_to(Path.cwd())
         sys.stdout.write(result.toml())
         return 0
     out = args.out if args.out is not None else Path(default_name(args.mechanism, inputs))
     design = new(args.mechanism, out=out, overrides=args.overrides, force=args.force, **inputs)
+    if design is None:  # a template to fill in
+        from gearcheck.params import read_toml
+
+        parts = read_toml(out).get("part", [])
+        print(f"wrote {out}: {len(parts)} parts, one per product of {args.step}: "
+              + ", ".join(p["name"] for p in parts[:12]) + (", …" if len(parts) > 12 else ""))
+        print(f"  fill in how they move ([[joint]], [[couple]], [motion]: examples at its end), "
+              f"then: gearcheck check {out}")
+        return 0
     print(f"wrote {out}: {design.impl.title}")
     print(f"  every derived value is commented with how it was found; check it: gearcheck check {out}")
     return 0
@@ -485,6 +510,7 @@ def _late_signal(signum: int, _frame: object) -> None:
 def main(argv: list[str] | None = None) -> int:
     """The command line (``argv`` None: ``sys.argv``, as the console script calls it); the exit
     code."""
+    _in_main.append(True)
     try:
         return _main(argv)
     except Interrupted as exc:
@@ -494,6 +520,7 @@ def main(argv: list[str] | None = None) -> int:
             return _interrupted(_received[0])
         raise
     finally:
+        _in_main.pop()
         if argv is None and signal.getsignal(signal.SIGINT) is _on_signal:
             signal.signal(signal.SIGINT, _late_signal)
             signal.signal(signal.SIGTERM, _late_signal)

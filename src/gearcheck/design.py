@@ -117,6 +117,9 @@ class Design:
     def resolved_data(self) -> dict:
         """The resolved parameters with the result name recorded, as written to params.toml."""
         rest = {k: v for k, v in self.data.items() if k not in RUN_KEYS}
+        resolve = getattr(self.params, "resolved", None)  # a template naming files: their absolute paths
+        if resolve is not None:
+            rest = resolve(rest)
         return {"mechanism": self.mechanism, "name": self.name, **rest}
 
     def default_tol_mm(self) -> float:
@@ -194,7 +197,7 @@ def from_data(data: dict, path: Path | None = None) -> Design:
                          f"allowed one of: {', '.join(known)}", source)
     _check_run_keys(data, path, source)
     body = {k: v for k, v in data.items() if k not in RUN_KEYS}
-    params = validate(registry.get(mech).Params, body, source)
+    params = validate(registry.get(mech).Params, body, source, path.parent if path is not None else None)
     return Design(path=path, mechanism=mech, params=params, data=data)
 
 

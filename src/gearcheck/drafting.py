@@ -54,6 +54,14 @@ class Draft:
     name: str
     header: list[str] = field(default_factory=list)
     sections: dict[str, dict[str, Entry]] = field(default_factory=dict)
+    #: arrays of tables (``[[part]]``), each a list of tables of keys, written after the sections
+    tables: dict[str, list[dict[str, Entry]]] = field(default_factory=dict)
+    #: lines written last, as comments (examples to fill in)
+    footer: list[str] = field(default_factory=list)
+    #: False: a template to fill in (``check`` refuses it until it is): written without validation
+    complete: bool = True
+    #: dotted keys holding a file path: written relative to the template's folder
+    paths: tuple[str, ...] = ()
 
     def set(self, dotted: str, value: Any, note: str = "") -> None:
         """Set ``section.key`` (a new key goes last in its section, a new section last)."""
@@ -72,7 +80,19 @@ class Draft:
         out: dict[str, Any] = {"mechanism": self.mechanism, "name": self.name}
         for section, keys in self.sections.items():
             out[section] = {k: e.value for k, e in keys.items()}
+        for name, tables in self.tables.items():
+            out[name] = [{k: e.value for k, e in table.items()} for table in tables]
         return out
+
+    def relative_to(self, folder: Path) -> None:
+        """Write the file paths (:attr:`paths`) relative to ``folder`` (the template's)."""
+        import os
+
+        for dotted in self.paths:
+            section, _, key = dotted.partition(".")
+            entry = self.sections.get(section, {}).get(key)
+            if entry is not None and os.path.isabs(str(entry.value)):
+                entry.value = os.path.relpath(str(entry.value), folder.resolve())
 
     def toml(self) -> str:
         """The template's text: the header as comments, then each section with a comment beside
@@ -99,6 +119,13 @@ class Draft:
         for section, keys in self.sections.items():
             lines += ["", f"[{section}]"]
             lines += [line(k, e.value, e.note) for k, e in keys.items()]
+        for name, tables in self.tables.items():
+            for table in tables:
+                lines += ["", f"[[{name}]]"]
+                lines += [line(k, e.value, e.note) for k, e in table.items()]
+        if self.footer:
+            lines.append("")
+            lines += [f"# {_one_line(f)}" if f.strip() else "#" for f in self.footer]
         return "\n".join(lines) + "\n"
 
 
@@ -192,19 +219,20 @@ def draft(mechanism: str, overrides: Mapping[str, Any] | Sequence[str] | None = 
 
 
 def new(mechanism: str, *, out: str | Path | None = None, overrides: Mapping[str, Any] | Sequence[str] | None = None,
-        force: bool = False, **inputs: Any) -> Design:
+        force: bool = False, **inputs: Any) -> Design | None:
     """A complete, validated design from the numbers that define it, e.g.
     ``new("differential", module=3, teeth="14/30")``, ``new("roller_chain", chain="12B", teeth=21)``.
 
     Every dependent value is derived (see each mechanism's docs); ``overrides`` (``{"section.key":
     value}`` or ``--set`` strings) change any other. With ``out`` the template is written there
     (an existing file only with ``force``) and the Design reads from it. Raises :class:`ParamError`
-    (exit 2 on the command line) when the numbers admit no design."""
+    (exit 2 on the command line) when the numbers admit no design. A template to fill in (an
+    ``assembly``'s: how its parts move is the user's to say) is written unvalidated, and gives None."""
     from gearcheck.design import from_data
     from gearcheck.output import atomic_write_text
 
     result = draft(mechanism, overrides, **inputs)
-    design = from_data(result.data())  # every rule of the template, before anything is written
+    design = from_data(result.data()) if result.complete else None  # every rule, before anything is written
     if out is None:
         return design
     path = Path(out)
@@ -214,13 +242,16 @@ def new(mechanism: str, *, out: str | Path | None = None, overrides: Mapping[str
         raise ParamError("--out", str(path), "allowed a file name ending in .toml")
     if not path.parent.is_dir():
         raise ParamError("--out", str(path), "its folder does not exist")
+    result.relative_to(path.parent)
     atomic_write_text(path, result.toml())  # an OSError: one OutputError line
-    return from_data(result.data(), path)
+    return from_data(result.data(), path) if result.complete else None
 
 
 def default_name(mechanism: str, inputs: Mapping[str, Any]) -> str:
     """``MECHANISM_NUMBERS.toml`` from the inputs given, e.g. ``differential_m3_z14-30.toml``."""
     parts = [mechanism]
+    if inputs.get("step") is not None:
+        return f"{mechanism}_{re.sub(r'[^A-Za-z0-9.]+', '-', Path(str(inputs['step'])).stem).strip('-')}.toml"
     for key, tag in (("chain", ""), ("module", "m"), ("teeth", "z"), ("strands", "x")):
         value = inputs.get(key)
         if value is not None:

@@ -234,11 +234,13 @@ def _value_problem(model: type[BaseModel], loc: tuple[str, ...], kind: str, valu
     return msg + (f" ({allowed})" if allowed else "")
 
 
-def validate(model: type[BaseModel], data: dict, source: str = "") -> BaseModel:
-    """Validate ``data`` against ``model``; any failure becomes one :class:`ParamError`."""
+def validate(model: type[BaseModel], data: dict, source: str = "", folder: Path | None = None) -> BaseModel:
+    """Validate ``data`` against ``model``; any failure becomes one :class:`ParamError`. ``folder``
+    (the template's, for a file it names; default the working folder) reaches the validators as
+    the validation context's ``folder``."""
     _reject_non_finite(data, (), source, model)
     try:
-        return model.model_validate(data)
+        return model.model_validate(data, context={"folder": folder})
     except ValidationError as exc:
         raise _errors(model, exc, data).with_source(source) from None
     except ParamError as exc:

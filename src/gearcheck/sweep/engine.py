@@ -101,6 +101,18 @@ class Scene:
         result = fcl.CollisionResult()
         return fcl.collide(self._object(a), self._object(b), request, result) > 0
 
+    def contact_normal(self, a: str, b: str, max_contacts: int = 100_000) -> np.ndarray | None:
+        """The mean normal (unit, world; from ``a`` towards ``b``, FCL's convention) of up to
+        ``max_contacts`` intersecting triangle pairs, or None where the surfaces do not intersect
+        or the normals cancel: the direction in which to push ``b`` off ``a``."""
+        request = fcl.CollisionRequest(num_max_contacts=max_contacts, enable_contact=True)
+        result = fcl.CollisionResult()
+        if fcl.collide(self._object(a), self._object(b), request, result) <= 0:
+            return None
+        n = np.sum([np.asarray(c.normal, float) for c in result.contacts], axis=0)
+        length = float(np.linalg.norm(n))
+        return n / length if length > 1e-12 else None
+
     def distance(self, a: str, b: str) -> Distance:
         request = fcl.DistanceRequest(enable_nearest_points=True, enable_signed_distance=False)
         result = fcl.DistanceResult()
