@@ -76,6 +76,7 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
     worst: list[WorstPose] = []
     pairs = {rule.key: _pair_entry(k, rule, lay, spec, data, by_name, bound[rule.key], worst)
              for k, rule in enumerate(spec.pairs)}
+    _certificates(spec, states, results, pairs)
     for rule in spec.pairs:
         entry = pairs[rule.key]
         if rule.key in spec.far:  # never within the margin: not queried
@@ -84,7 +85,7 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
             a, b = triangles[rule.key]
             entry["triangles_swept"] = [a, b]
             entry["triangles_total"] = [int(bodies[p].mesh.faces.shape[0]) for p in (rule.a, rule.b)]
-            if entry.get("min_clearance_mm", 0.0) > spec.margin:
+            if min(entry.get("min_clearance_mm", 0.0), entry.get("sampled_min_mm", math.inf)) > spec.margin:
                 entry["apart_beyond_mm"] = spec.margin  # the pruned meshes' distance: only known to exceed it
     summary["pairs"] = pairs
     if spec.play:
@@ -97,6 +98,29 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
                        ms_per_play_measurement_max=1e3 * float(np.max(play_s)))
     return SweepOutcome(summary, worst, timings,
                         AssemblySweep(lay, spec, data, bound, queries))
+
+
+def _certificates(spec: Spec, states: list[StateSpec], results: list, pairs: dict) -> None:
+    """Each certified pair's figures over the motion and the states, into its entry: the certified
+    least clearance (a lower bound over the continuous motion) and the interval it lies in, the
+    least clearance measured (poses and refinement points), the refinement's measurements and the
+    intervals it left undecided (too short to split: within the meshes' error)."""
+    unit = spec.kin.unit
+    per_state = len(results) // len(states)
+    for s, st in enumerate(states):
+        for r in results[s * per_state:(s + 1) * per_state]:
+            for key, c in r["certificates"].items():
+                entry = pairs[key]
+                if c["certified_min"] < entry.get("certified_min_mm", math.inf):
+                    entry.update({"certified_min_mm": c["certified_min"], f"certified_min_between_{unit}": c["at"],
+                                  "certified_min_state": st.name})
+                entry["sampled_min_mm"] = min(entry.get("sampled_min_mm", math.inf), c["sampled_min"])
+                entry["intervals_refined"] = entry.get("intervals_refined", 0) + c["refined"]
+                entry["undecided_intervals"] = entry.get("undecided_intervals", 0) + c["undecided"]
+    for entry in pairs.values():
+        for key in ("certified_min_mm", "sampled_min_mm"):
+            if key in entry and not math.isfinite(entry[key]):  # an overlap beyond measure: the verdict says so
+                entry.pop(key)
 
 
 def _pair_entry(k: int, rule, lay: Layout, spec: Spec, data: list[StateResult], by_name: dict[str, StateSpec],

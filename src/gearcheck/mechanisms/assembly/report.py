@@ -15,7 +15,7 @@ import numpy as np
 
 from gearcheck.mechanisms.assembly.assembly import PairRule
 from gearcheck.mechanisms.assembly.reduce import AssemblySweep
-from gearcheck.results import Plot, Report, Series, SweepOutcome, Verdict
+from gearcheck.results import Level, Plot, Report, Series, SweepOutcome, Verdict
 
 MESH = "mesh sweep (FCL collide and distance at every pose)"
 PLAY = "mesh sweep (bisection to contact both ways at every pose)"
@@ -41,6 +41,34 @@ def _overlap_words(entry: dict, unit: str) -> str:
     move = entry.get("max_overlap_move")
     extra = f"; a {move:.4g}° turn frees it" if move is not None and mm is not None and move != mm else ""
     return f"overlap {mm:.4f} mm {where} (along the motion{extra})"
+
+
+CERTIFIED = "mesh sweep, certified over the continuous motion (each interval's bound from its ends' clearances " \
+            "and the largest path of any point; refined where it did not decide)"
+
+
+def clearance_reading(entry: dict, required: float, unit: str) -> tuple[Level, str, str]:
+    """(level, measured, shortfall) of a pair's clearance against ``required`` over the continuous
+    motion, from its certificate: pass where the certified bound holds; fail where a pose (sampled
+    or added by the refinement) falls short; warn where the bound is below the requirement only
+    on intervals too short to split (within the meshes' error)."""
+    cert, sampled = entry.get("certified_min_mm"), entry.get("sampled_min_mm")
+    refined, undecided = entry.get("intervals_refined", 0), entry.get("undecided_intervals", 0)
+    between = entry.get(f"certified_min_between_{unit}")
+    where = (f" between {_value(between[0], unit)} and {_value(between[1], unit)}" if between else "")
+    state = entry.get("certified_min_state", "as_built")
+    where += f", {state}" if state != "as_built" else ""
+    if cert is None or sampled is None:
+        return "fail", "no certified figure", "an overlap beyond measure"
+    head = f"least clearance ≥ {cert:.4f} mm certified over the continuous motion{where}"
+    tail = f" (least measured {sampled:.4f} mm, {refined} points added between the poses)"
+    if cert >= required:
+        return "pass", head + tail, ""
+    if sampled < required:
+        return ("fail", head + tail, f"a pose between the samples comes to {sampled:.4f} mm against {required:g} mm"
+                + where)
+    return ("warn", head + tail + f"; {undecided} intervals within the meshes' error of {required:g} mm",
+            f"certified {cert:.4f} mm against {required:g} mm on intervals too short to decide (the meshes' error)")
 
 
 def pair_verdict(rule: PairRule, entry: dict, unit: str, tol: float) -> Verdict:
@@ -73,18 +101,30 @@ def pair_verdict(rule: PairRule, entry: dict, unit: str, tol: float) -> Verdict:
         ok = False
     elif beyond is not None and (least is None or least > beyond):
         ok, shortfall = beyond >= required, ""
+    elif "certified_min_mm" in entry or "sampled_min_mm" in entry:
+        level, measured, shortfall = clearance_reading(entry, required, unit)
+        figures.update({k: entry[k] for k in ("certified_min_mm", "sampled_min_mm") if k in entry})
+        return Verdict.graded(name, _label(rule, required), level, measured, figures, evidence=CERTIFIED,
+                              shortfall=shortfall)
     else:
         ok = least is not None and least >= required
         shortfall = (f"least clearance {least:.4f} mm against {required:g} mm" if least is not None
                      else "never apart")
-    label = (f"{rule.a} and {rule.b} keep ≥ {required:g} mm apart" if required > 0
-             else f"{rule.a} and {rule.b} do not interfere")
     measured = least_words + (f"; {overlaps} poses overlap" if overlaps else "")
-    return Verdict.of(name, label, ok, measured, figures, evidence=MESH, shortfall=shortfall)
+    return Verdict.of(name, _label(rule, required), ok, measured, figures, evidence=MESH, shortfall=shortfall)
+
+
+def _label(rule: PairRule, required: float) -> str:
+    return (f"{rule.a} and {rule.b} keep ≥ {required:g} mm apart" if required > 0
+            else f"{rule.a} and {rule.b} do not interfere")
 
 
 def others_verdict(rules: list[PairRule], pairs: dict, unit: str) -> Verdict:
     """Every pair no [[require]] names: no interference anywhere in the motion."""
+    readings = {r.key: clearance_reading(pairs[r.key], 0.0, unit) for r in rules
+                if not pairs[r.key].get("overlapping_poses", 0) and "certified_min_mm" in pairs[r.key]}
+    between = [(r, pairs[r.key]) for r in rules if readings.get(r.key, ("pass",))[0] == "fail"]
+    unsure = [(r, pairs[r.key]) for r in rules if readings.get(r.key, ("pass",))[0] == "warn"]
     bad = [(r, pairs[r.key]) for r in rules if pairs[r.key].get("overlapping_poses", 0)]
     free = [pairs[r.key]["min_clearance_mm"] for r in rules if "min_clearance_mm" in pairs[r.key]]
     far = sum("apart_beyond_mm" in pairs[r.key] and "min_clearance_mm" not in pairs[r.key] for r in rules)
@@ -92,12 +132,17 @@ def others_verdict(rules: list[PairRule], pairs: dict, unit: str) -> Verdict:
     if far:
         beyond = next(pairs[r.key]["apart_beyond_mm"] for r in rules if "apart_beyond_mm" in pairs[r.key])
         measured += f"; {far} never within {beyond:g} mm of each other"
-    shortfall = "; ".join(f"{r.a} – {r.b} {_overlap_words(e, unit)}" for r, e in bad[:3])
-    if len(bad) > 3:
-        shortfall += f"; {len(bad) - 3} more pairs"
-    return Verdict.of("no_interference", "no other pair of parts interferes", not bad, measured,
-                      {"pairs": float(len(rules)), "overlapping_pairs": float(len(bad))}, evidence=MESH,
-                      shortfall=shortfall)
+    shortfall = "; ".join([f"{r.a} – {r.b} {_overlap_words(e, unit)}" for r, e in bad[:3]]
+                          + [f"{r.a} – {r.b}: {readings[r.key][2]}" for r, _ in (between + unsure)[:3]])
+    if len(bad) + len(between) + len(unsure) > 3:
+        shortfall += f"; {len(bad) + len(between) + len(unsure) - 3} more pairs"
+    level: Level = "fail" if bad or between else "warn" if unsure else "pass"
+    certified = [pairs[r.key]["certified_min_mm"] for r in rules if "certified_min_mm" in pairs[r.key]]
+    if certified and not bad:
+        measured += f"; certified ≥ {min(certified):.4f} mm over the continuous motion"
+    return Verdict.graded("no_interference", "no other pair of parts interferes", level, measured,
+                          {"pairs": float(len(rules)), "overlapping_pairs": float(len(bad) + len(between))},
+                          evidence=CERTIFIED, shortfall=shortfall)
 
 
 def play_verdict(summary: dict, minimum: float | None) -> Verdict:

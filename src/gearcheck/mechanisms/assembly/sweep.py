@@ -33,37 +33,20 @@ import numpy as np
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.assembly.assembly import Layout, PairRule
 from gearcheck.mechanisms.assembly.kinematics import Kinematics
+from gearcheck.mechanisms.assembly.meshes import (AS_BUILT, StateSpec, pair_meshes, play_meshes, state_meshes,
+                                                  state_specs)
+from gearcheck.mechanisms.assembly.meshes import axis_radius as _radius
+from gearcheck.mechanisms.assembly.meshes import box_corners as _corners
 from gearcheck.results import SweepOutcome, WorstPose
-from gearcheck.sweep.bodies import Body, MeshData, submesh
+from gearcheck.sweep.bodies import Body
+from gearcheck.sweep.certify import certify
 from gearcheck.sweep.motion import Rotation
 from gearcheck.geometry.bisect import bisect, bisect_predicted, remembered
-from gearcheck.sweep.prune import approaching_faces, largest_step, near_faces
 from gearcheck.sweep.tools import CountedScene, clearing_distance
 
 BISECT_DEG = 2e-4  # play and overlap bisections stop at this bracket (deg: 0.72″, 1.7e-4 mm at r = 50) ...
 BISECT_MM = 1e-5  # ... or this (mm)
 POSES_PER_TASK = 24
-AS_BUILT = "as_built"
-
-
-@dataclass(frozen=True)
-class StateSpec:
-    """One state: its name and each part's scale and datum (the file's frame)."""
-
-    name: str
-    scales: dict[str, float]
-    datums: dict[str, tuple[float, float, float]]
-
-    def fold(self, part: str, pose: np.ndarray) -> np.ndarray:
-        """The pose of a part scaled about its datum, as a pose of the part scaled about its own
-        origin (what a WorstPose carries): pose @ translation((1 − s)·d)."""
-        s = self.scales.get(part, 1.0)
-        d = np.asarray(self.datums.get(part, (0.0, 0.0, 0.0)), float)
-        shift = np.eye(4)
-        shift[:3, 3] = (1.0 - s) * d
-        return pose @ shift
-
-
 @dataclass(frozen=True)
 class Spec:
     """What every task needs (picklable): the kinematics, the pair rules, the play part, and each
@@ -84,6 +67,11 @@ class Spec:
     # the play part against each neighbour, per turning sense (+1, −1): (its mesh, the neighbour's),
     # each kept to the faces that motion can meet first (sweep.prune.approaching_faces)
     play_meshes: dict[tuple[str, float], tuple[str, str]]
+    # per pair: the corners of its two pruned meshes' boxes, each in its part's frame, for the bound
+    # on how fast the clearance can change over an interval (:func:`interval_path`)
+    boxes: dict[str, tuple[np.ndarray, np.ndarray]]
+    grown: float  # the largest thermal scale: a state's meshes are no larger than this times the built
+    resolution: dict[str, float]  # per pair: its mesh-error bound, the sharpest a bound can be
 
     def mesh(self, rule: PairRule, part: str, state: str) -> str:
         """The mesh of ``part`` against the other part of ``rule``, in ``state``."""
@@ -103,13 +91,6 @@ def _overlap_mover(spec: Spec, rule: PairRule) -> str | None:
     jointed = [p for p in (rule.b, rule.a) if p in spec.kin.lines]
     driven = [p for p in jointed if p != spec.kin.driver]
     return (driven or jointed)[0] if jointed else None
-
-
-def _radius(line, point: np.ndarray) -> float:
-    """Distance of a world point from a revolute joint's axis (mm)."""
-    axis, origin = np.asarray(line.motion.axis, float), np.asarray(line.motion.origin, float)
-    v = point - origin
-    return float(np.linalg.norm(v - axis * (v @ axis)))
 
 
 def _overlap(scene: CountedScene, spec: Spec, rule: PairRule, state: str, x: float) -> tuple[float, float]:
@@ -319,9 +300,31 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
     return moves[0], moves[1], touched[0], touched[1]
 
 
-def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool) -> dict:
+def _certified(scene: CountedScene, spec: Spec, rule: PairRule, state: str, xs: list[float],
+               cs: list[float]) -> dict:
+    """The pair's clearance certified over the motion through the coordinates ``xs`` (clearances
+    ``cs``, negative where overlapping): :func:`gearcheck.sweep.certify.certify`, a distance query at
+    each refinement point (an overlap there: the overlap along the motion, negative)."""
+    a, b = spec.mesh(rule, rule.a, state), spec.mesh(rule, rule.b, state)
+    def measure(x: float) -> float:
+        scene.set_pose(a, spec.kin.pose(rule.a, x))
+        scene.set_pose(b, spec.kin.pose(rule.b, x))
+        if scene.collide(a, b):
+            depth = _overlap(scene, spec, rule, state, x)[0]
+            return -depth if math.isfinite(depth) and depth > 0.0 else -BISECT_MM
+        return scene.distance(a, b).distance
+
+    cert = certify(xs, cs, measure, functools.partial(interval_path, spec, rule), rule.min_clearance_mm,
+                   spec.resolution[rule.key])
+    return {"certified_min": cert.certified_min, "sampled_min": cert.sampled_min, "at": list(cert.at),
+            "refined": cert.refined, "undecided": len(cert.undecided)}
+
+
+def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, after: int | None = None) -> dict:
     """One task: the poses ``indices`` of one state (``first``: the motion's first pose is among
-    them, where pairs that do not move relative to each other are checked)."""
+    them, where pairs that do not move relative to each other are checked), and each moving pair's
+    clearance certified over the motion from the first of them to the pose ``after`` (the next
+    task's first, measured here too, not recorded: every interval is certified by one task)."""
     scene = CountedScene(scene)
     kin = spec.kin
     n, m = len(indices), len(spec.pairs)
@@ -353,132 +356,66 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool) 
                       for k, r in enumerate(spec.pairs) if spec.play in (r.a, r.b) and r.key not in spec.far)
             play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])))
             play_s.append(time.perf_counter() - t0)
+    certificates: dict[str, dict] = {}
+    for k, rule in enumerate(spec.pairs):
+        if rule.key in spec.far or not rule.moving or rule.kind == "contact":
+            continue
+        xs = [float(kin.coordinates[i]) for i in indices]
+        cs = [float(c) for c in clearance[:, k]]
+        if after is not None:
+            x = float(kin.coordinates[after])
+            a, b = spec.mesh(rule, rule.a, state), spec.mesh(rule, rule.b, state)
+            scene.set_pose(a, kin.pose(rule.a, x))
+            scene.set_pose(b, kin.pose(rule.b, x))
+            xs.append(x)
+            cs.append(-BISECT_MM if scene.collide(a, b) else scene.distance(a, b).distance)
+        certificates[rule.key] = _certified(scene, spec, rule, state, xs, cs)
     return {"indices": list(indices), "clearance": clearance, "overlap_mm": overlap_mm,
             "overlap_unit": overlap_unit, "points": points, "play": play, "queries": scene.queries,
-            "play_s": play_s, "seconds": time.perf_counter() - start}
+            "play_s": play_s, "seconds": time.perf_counter() - start, "certificates": certificates}
 
 
-def state_specs(layout: Layout, bodies: Mapping[str, Body]) -> list[StateSpec]:
-    """The file's own state, then each declared temperature state (each part by its own CTE)."""
-    out = [StateSpec(AS_BUILT, {}, {})]
-    for name, temp, ref in layout.states:
-        scales, datums = {}, {}
-        for part, body in bodies.items():
-            scales[part] = 1.0 + layout.cte_per_K.get(part, 0.0) * (temp - ref)
-            d = layout.datum.get(part)
-            if d is None:
-                v = body.mesh.vertices
-                d = tuple(0.5 * (v.min(axis=0) + v.max(axis=0)))
-            datums[part] = (float(d[0]), float(d[1]), float(d[2]))
-        out.append(StateSpec(name, scales, datums))
-    return out
+def _velocity(kin: Kinematics, part: str, w: np.ndarray) -> np.ndarray:
+    """The velocity of ``part``'s motion at world points ``w`` ((n, 3)), per unit of the driver's
+    coordinate (mm per deg or per mm): its joint's gain times its turn's (or slide's) field."""
+    line = kin.lines.get(part)
+    if line is None or not line.coupled:
+        return np.zeros_like(w)
+    a = np.asarray(line.motion.axis, float)
+    if isinstance(line.motion, Rotation):
+        return line.gain * math.pi / 180.0 * np.cross(a, w - np.asarray(line.motion.origin, float))
+    return np.broadcast_to(line.gain * a, w.shape)
 
 
-def _corners(mesh: MeshData) -> np.ndarray:
-    v = np.asarray(mesh.vertices, float)
-    lo, hi = v.min(axis=0), v.max(axis=0)
+def _placed_box(spec: Spec, part: str, corners: np.ndarray, x0: float, x1: float) -> np.ndarray:
+    """The corners of a world box holding the part's (pruned) mesh at every coordinate in [x0, x1]:
+    the box of its frame's box placed at both ends, grown by the longest path of a corner between
+    them (every point of a path lies within that of its start)."""
+    m0, m1 = spec.kin.pose(part, x0), spec.kin.pose(part, x1)
+    p0, p1 = corners @ m0[:3, :3].T + m0[:3, 3], corners @ m1[:3, :3].T + m1[:3, 3]
+    line = spec.kin.lines.get(part)
+    path = 0.0
+    if line is not None and line.coupled:
+        move = abs(line.gain * (x1 - x0))
+        path = move if line.unit == "mm" else max(_radius(line, c) for c in p0) * math.radians(move)
+    both = np.concatenate([p0, p1])
+    lo, hi = both.min(axis=0) - path, both.max(axis=0) + path
     return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
 
 
-def _reach_mm(kin: Kinematics, part: str, move: float, corners: np.ndarray) -> float:
-    """The largest displacement (mm) of any point of ``part`` when its joint moves by ``move``."""
-    line = kin.lines.get(part)
-    if line is None or move <= 0.0:
-        return 0.0
-    if line.unit == "mm":
-        return move
-    return max(_radius(line, c) for c in corners) * 2.0 * math.sin(math.radians(move) / 2.0)
-
-
-def _base_margin(lay: Layout) -> float:
-    """The distance below which every figure of a pruned pair is exact (mm): at least 1 mm, twice
-    the largest required clearance and twice the contact tolerance."""
-    required = [r.min_clearance_mm for r in lay.pairs if r.kind == "clearance"]
-    return max(1.0, 2.0 * max(required, default=0.0), 2.0 * lay.contact_tolerance_mm)
-
-
-def pair_meshes(lay: Layout, kin: Kinematics, bodies: Mapping[str, Body], states: list[StateSpec]
-                ) -> tuple[dict[str, tuple[MeshData, MeshData]], frozenset[str], dict[str, float], float]:
-    """Each pair's two meshes pruned to what comes within the margin of the other over the motion
-    (:mod:`gearcheck.sweep.prune`); the pairs never within it; each pair's clearing-move reach (the
-    mover's unit: a move that displaces no point more than the base margin); the base margin."""
-    base = _base_margin(lay)
-    corners = {p: _corners(b.mesh) for p, b in bodies.items()}
-    growth = max((abs(st.scales.get(p, 1.0) - 1.0) * float(np.linalg.norm(c - np.asarray(st.datums.get(p, (0, 0, 0))),
-                                                                          axis=1).max())
-                  for st in states for p, c in corners.items()), default=0.0)
-    meshes, far, reach = {}, set(), {}
-    for rule in lay.pairs:
-        mover = next((p for p in (rule.b, rule.a) if p in kin.lines and p != kin.driver),
-                     next((p for p in (rule.b, rule.a) if p in kin.lines), None))
-        if mover is None:
-            reach[rule.key] = 0.0
-        else:
-            unit_reach = _reach_mm(kin, mover, 1.0, corners[mover])  # mm per unit move (deg or mm)
-            reach[rule.key] = base / unit_reach if unit_reach > 0 else 0.0
-        play_reach = max((_reach_mm(kin, p, lay.play_limit, corners[p]) for p in (rule.a, rule.b) if p == lay.play),
-                         default=0.0)
-        xs = kin.coordinates if rule.moving else kin.coordinates[:1]
-        masks = []
-        for me, other in ((rule.a, rule.b), (rule.b, rule.a)):
-            rel = np.array([np.linalg.inv(kin.pose(me, float(x))) @ kin.pose(other, float(x)) for x in xs])
-            margin = base + max(base, play_reach) + largest_step(corners[other], rel) + 2.0 * growth
-            masks.append(near_faces(bodies[me].mesh, bodies[other].mesh, rel, margin))
-        if not masks[0].any() or not masks[1].any():
-            far.add(rule.key)
-            continue
-        meshes[rule.key] = tuple(submesh(bodies[me].mesh, f"{me}~{other}", mask) if not mask.all()
-                                 else MeshData(f"{me}~{other}", bodies[me].mesh.vertices, bodies[me].mesh.faces)
-                                 for (me, other), mask in zip(((rule.a, rule.b), (rule.b, rule.a)), masks, strict=True))
-    return meshes, frozenset(far), reach, base  # type: ignore[return-value]
-
-
-def play_meshes(lay: Layout, kin: Kinematics, bodies: Mapping[str, Body], pairs: dict[str, tuple[MeshData, MeshData]]
-                ) -> dict[tuple[str, float], tuple[MeshData, MeshData]]:
-    """The play part and each neighbour's pruned meshes cut, for each turning sense, to the faces
-    that motion can meet first: the other sense's flanks, a backlash away, left out of the BVHs
-    every contact bisection traverses (the same contact, found faster)."""
-    part = lay.play
-    if part is None:
-        return {}
-    line = kin.lines[part]
-    axis = np.asarray(line.motion.axis, float)
-    origin = np.asarray(line.motion.origin, float) if isinstance(line.motion, Rotation) else None
-    out = {}
-    for n in lay.play_neighbours:
-        rule = next(r for r in lay.pairs if {r.a, r.b} == {part, n})
-        if rule.key not in pairs:
-            continue
-        mine, theirs = pairs[rule.key] if rule.a == part else pairs[rule.key][::-1]
-        # the play joint's axis in the neighbour's frame at every pose (both joints fixed in the world)
-        inv = [np.linalg.inv(kin.pose(n, float(x))) for x in kin.coordinates]
-        axes = np.array([m[:3, :3] @ axis for m in inv])
-        origins = None if origin is None else np.array([m[:3, :3] @ origin + m[:3, 3] for m in inv])
-        for sign in (1.0, -1.0):
-            keep_mine = approaching_faces(mine, axis, origin, sign, moving=True)
-            keep_theirs = approaching_faces(theirs, axes, origins, sign, moving=False)
-            if not (keep_mine.any() and keep_theirs.any()):  # nothing that sense could meet: whole meshes
-                keep_mine, keep_theirs = np.ones(len(mine.faces), bool), np.ones(len(theirs.faces), bool)
-            tag = "+" if sign > 0 else "-"
-            out[(n, sign)] = (submesh(mine, f"{mine.name}{tag}", keep_mine),
-                              submesh(theirs, f"{theirs.name}{tag}", keep_theirs))
-    return out
-
-
-def state_meshes(states: list[StateSpec], bodies: Mapping[str, Body],
-                 pairs: dict[str, tuple[MeshData, MeshData]]) -> list[MeshData]:
-    """Every pair's pruned meshes in every state (a state's: scaled about each part's datum)."""
-    meshes = []
-    for st in states:
-        for mesh_a, mesh_b in pairs.values():
-            for mesh in (mesh_a, mesh_b):
-                part = mesh.name.partition("~")[0]
-                if st.name == AS_BUILT:
-                    meshes.append(mesh)
-                    continue
-                scale, datum = st.scales[part], np.asarray(st.datums[part], float)
-                meshes.append(MeshData(f"{mesh.name}@{st.name}", datum + (mesh.vertices - datum) * scale, mesh.faces))
-    return meshes
+def interval_path(spec: Spec, rule: PairRule, x0: float, x1: float) -> float:
+    """The longest path (mm) any point of one of the pair's meshes can take relative to the other
+    part over [x0, x1]: |x1 − x0| times the largest relative speed |v_a(w) − v_b(w)| of the two
+    motions' velocity fields (per unit of the driver) over a world box that holds the mesh all the
+    while; the speed is convex in w, so a corner of the box has the largest. The clearance changes
+    by no more (the distance does not change when both bodies are placed in one's frame, where only
+    the other moves); the smaller of the two meshes' figures is taken, grown by the thermal scale."""
+    best = math.inf
+    for part, other, corners in ((rule.a, rule.b, spec.boxes[rule.key][0]), (rule.b, rule.a, spec.boxes[rule.key][1])):
+        box = _placed_box(spec, part, corners, x0, x1)
+        speed = float(np.linalg.norm(_velocity(spec.kin, part, box) - _velocity(spec.kin, other, box), axis=1).max())
+        best = min(best, speed)
+    return spec.grown * best * abs(x1 - x0)
 
 
 def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None) -> SweepPlan:
@@ -493,16 +430,20 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     directed = play_meshes(lay, kin, bodies, pairs)
     play = {key: (a.name, b.name) for key, (a, b) in directed.items()}
     centres = {p: tuple(float(c) for c in _corners(b.mesh).mean(axis=0)) for p, b in bodies.items()}
+    grown = 1.0 + max((abs(s - 1.0) for st in states for s in st.scales.values()), default=0.0)
+    boxes = {key: (_corners(ma), _corners(mb)) for key, (ma, mb) in pairs.items()}
+    resolution = {r.key: bodies[r.a].error_bound_mm + bodies[r.b].error_bound_mm for r in lay.pairs}
     spec = Spec(kin, lay.pairs, lay.play, lay.play_limit, lay.play_neighbours,
                 {k: (a.name, b.name) for k, (a, b) in pairs.items()}, far, reach, margin,
-                centres, play)  # type: ignore[arg-type]
+                centres, play, boxes, grown, resolution)  # type: ignore[arg-type]
     per_task = int(options.get("poses_per_task", POSES_PER_TASK))
     count = len(kin.coordinates)
     tasks, weights = [], []
     for st in states:
         for start in range(0, count, per_task):
             idx = list(range(start, min(count, start + per_task)))
-            tasks.append((sweep_poses, (spec, st.name, idx, start == 0)))
+            after = idx[-1] + 1 if idx[-1] + 1 < count else None
+            tasks.append((sweep_poses, (spec, st.name, idx, start == 0, after)))
             weights.append(len(idx))
 
     def reduce(results: list) -> SweepOutcome:

@@ -1,0 +1,67 @@
+"""Clearance certified over the continuous motion (gearcheck.sweep.certify): a lower bound between
+samples from the ends' clearances and the largest displacement, refined where it does not decide.
+The case of a minimum between two samples: sampled, the requirement passes; certified, the true
+figure is found and it fails."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from gearcheck.sweep.certify import arc_displacement, certify, interval_bound
+
+RADIUS = 5.0  # a fixed disc at the origin; a point moves along the line y = H past it
+H = 5.2
+
+
+def clearance(x: float) -> float:
+    return math.hypot(x, H) - RADIUS
+
+
+def test_the_interval_bound_is_a_lower_bound():
+    rng = np.random.default_rng(3)
+    for _ in range(2000):
+        x0, x1 = sorted(rng.uniform(-20, 20, 2))
+        inside = np.linspace(x0, x1, 101)
+        true = min(clearance(float(x)) for x in inside)
+        bound = interval_bound(clearance(x0), clearance(x1), abs(x1 - x0))  # a translation: δ = |Δx|
+        assert bound <= true + 1e-12
+
+
+def test_a_minimum_between_two_samples_is_caught():
+    xs = [-3.0, 3.0]  # the closest approach (x = 0: 0.2 mm) lies between the two samples
+    cs = [clearance(x) for x in xs]
+    requirement = 0.5
+    assert min(cs) > requirement  # sampled: a pass
+    calls = []
+
+    def measure(x: float) -> float:
+        calls.append(x)
+        return clearance(x)
+
+    cert = certify(xs, cs, measure, lambda a, b: abs(b - a), requirement, resolution=1e-4)
+    assert not cert.passed and cert.sampled_min == pytest.approx(0.2, abs=1e-9)  # the true figure, a fail
+    assert cert.certified_min <= 0.2 and cert.refined == len(calls) > 0
+    assert cert.at[0] <= 0.0 <= cert.at[1] or min(abs(cert.at[0]), abs(cert.at[1])) < 1e-6
+
+
+def test_a_clear_motion_is_certified_with_few_measurements():
+    xs = list(np.linspace(-20, 20, 41))
+    cs = [clearance(x) for x in xs]
+    cert = certify(xs, cs, clearance, lambda a, b: abs(b - a), 0.1, resolution=1e-4)
+    assert cert.passed and cert.decides
+    assert 0.1 <= cert.certified_min <= 0.2 and cert.refined < 40
+
+
+def test_a_requirement_met_only_within_the_resolution_is_left_undecided():
+    xs = [-1.0, 1.0]
+    cs = [clearance(x) for x in xs]
+    cert = certify(xs, cs, clearance, lambda a, b: abs(b - a), 0.2, resolution=1e-3)
+    assert cert.undecided and all(x1 - x0 <= 1e-3 for x0, x1, _ in cert.undecided)
+    assert cert.certified_min == pytest.approx(0.2, abs=1e-3)
+
+
+def test_a_turn_moves_a_point_by_its_arc():
+    assert arc_displacement(10.0, 180.0) == pytest.approx(10 * math.pi)
