@@ -12,7 +12,6 @@ import functools
 import hashlib
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -166,17 +165,3 @@ def build_parts(assembly: Assembly) -> list:
             raise ParamError(solid.file_field, solid.path, str(exc).removeprefix(f"{solid.path}: ")) from None
         out.append(Part(spec.name, spec.material, part_solid(product), spec.pose, spec.color, spec.motion))
     return out
-
-
-def products_of(path: str | Path) -> list[tuple[str, int, float, tuple]]:
-    """(name, solids, volume mm³, bounding box) of every product of a STEP file (for ``new``)."""
-    from gearcheck.cad.step_import import read_step
-
-    f = read_step(path)
-    return [(p.name, p.solids, p.volume_mm3, p.bbox) for p in f.products]
-
-
-def file_unit(path: str | Path) -> str:
-    from gearcheck.cad.step_import import read_step
-
-    return read_step(path).unit

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from gearcheck.mechanisms.assembly.assembly import Layout
+from gearcheck.mechanisms.assembly.assembly import Layout, PairRule
 from gearcheck.mechanisms.assembly.kinematics import Kinematics
 from gearcheck.sweep.bodies import Body, MeshData, submesh
 from gearcheck.sweep.motion import Rotation
@@ -60,6 +60,13 @@ def state_specs(layout: Layout, bodies: Mapping[str, Body]) -> list[StateSpec]:
     return out
 
 
+def overlap_mover(kin: Kinematics, rule: PairRule) -> str | None:
+    """The part moved to free an overlapping pair: a jointed part of the pair, the driven one first."""
+    jointed = [p for p in (rule.b, rule.a) if p in kin.lines]
+    driven = [p for p in jointed if p != kin.driver]
+    return (driven or jointed)[0] if jointed else None
+
+
 def box_corners(mesh: MeshData) -> np.ndarray:
     """The corners of the mesh's box, in its own frame (every vertex lies inside it)."""
     v = np.asarray(mesh.vertices, float)
@@ -96,8 +103,7 @@ def pair_meshes(lay: Layout, kin: Kinematics, bodies: Mapping[str, Body], states
                   for st in states for p, c in corners.items()), default=0.0)
     meshes, far, reach = {}, set(), {}
     for rule in lay.pairs:
-        mover = next((p for p in (rule.b, rule.a) if p in kin.lines and p != kin.driver),
-                     next((p for p in (rule.b, rule.a) if p in kin.lines), None))
+        mover = overlap_mover(kin, rule)
         if mover is None:
             reach[rule.key] = 0.0
         else:

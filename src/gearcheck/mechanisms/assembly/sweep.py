@@ -36,6 +36,7 @@ from gearcheck.mechanisms.assembly.kinematics import Kinematics
 from gearcheck.mechanisms.assembly.meshes import (AS_BUILT, StateSpec, pair_meshes, play_meshes, state_meshes,
                                                   state_specs)
 from gearcheck.mechanisms.assembly.meshes import axis_radius as _radius
+from gearcheck.mechanisms.assembly.meshes import overlap_mover
 from gearcheck.mechanisms.assembly.meshes import box_corners as _corners
 from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body
@@ -86,18 +87,11 @@ def _unit_tol(unit: str) -> float:
     return BISECT_DEG if unit == "deg" else BISECT_MM
 
 
-def _overlap_mover(spec: Spec, rule: PairRule) -> str | None:
-    """The part moved to free an overlapping pair: a jointed part of the pair, the driven one first."""
-    jointed = [p for p in (rule.b, rule.a) if p in spec.kin.lines]
-    driven = [p for p in jointed if p != spec.kin.driver]
-    return (driven or jointed)[0] if jointed else None
-
-
 def _overlap(scene: CountedScene, spec: Spec, rule: PairRule, state: str, x: float) -> tuple[float, float]:
     """(overlap along the motion in mm, in the mover's unit) of a pair whose meshes intersect at
     driver coordinate ``x``: the smaller of the two clearing moves (searched up to the pair's
     reach); NaN without a jointed part; where no move of the joint frees it, the least push."""
-    mover = _overlap_mover(spec, rule)
+    mover = overlap_mover(spec.kin, rule)
     other_part = rule.a if mover == rule.b else rule.b
     if mover is None:
         return math.nan, math.nan
