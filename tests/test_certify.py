@@ -65,3 +65,14 @@ def test_a_requirement_met_only_within_the_resolution_is_left_undecided():
 
 def test_a_turn_moves_a_point_by_its_arc():
     assert arc_displacement(10.0, 180.0) == pytest.approx(10 * math.pi)
+
+
+def test_sharpening_brings_the_figure_to_the_true_least_clearance():
+    xs = list(np.linspace(-20, 20, 9))  # 5 mm apart: the bound alone is far below the true 0.2 mm
+    cs = [clearance(x) for x in xs]
+    loose = certify(xs, cs, clearance, lambda a, b: abs(b - a), 0.0, resolution=1e-6)
+    sharp = certify(xs, cs, clearance, lambda a, b: abs(b - a), 0.0, resolution=1e-6, precision=1e-4, sharpen=400)
+    assert loose.passed and loose.certified_min < 0.1  # decided, but far below the true 0.2 mm
+    assert sharp.certified_min <= 0.2 + 1e-12  # still a lower bound of the true least clearance ...
+    assert sharp.certified_min == pytest.approx(0.2, abs=2e-3)  # ... and close to it
+    assert loose.refined < sharp.refined <= loose.refined + 400

@@ -152,3 +152,15 @@ def test_an_interrupt_during_all_leaves_no_workers_staging_folder(tmp_path, verb
     assert "Traceback" not in err
     left = sorted(p.name for p in out.iterdir() if not p.name.endswith(".lock"))
     assert not [n for n in left if ".staging-" in n or ".old-" in n], left
+
+
+def test_the_interrupt_message_imports_nothing():
+    """CI saw a libmpdec warning above the one line: SIGINT landed while pydantic imported
+    ``decimal``, and the message's own import of the output module imported it again (a half-made C
+    module warns when made twice). The message now reads the output module only if it is loaded."""
+    code = ("import sys; from gearcheck import cli; before = set(sys.modules); "
+            "code = cli._interrupted(2); new = sorted(set(sys.modules) - before); "
+            "print(code, new)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
+    assert done.stdout.split() == ["130", "[]"], done.stdout
+    assert done.stderr == "gearcheck: interrupted (SIGINT): nothing written\n"

@@ -476,13 +476,16 @@ def _error(text: str, code: int = 2) -> int:
 
 
 def _interrupted(signum: int) -> int:
-    """One line, exit 128 + signal: what the run folder holds now."""
-    from gearcheck.output import RunFolder
-
-    if RunFolder.written:  # the new run was swapped in before the interrupt took effect
-        what = f"{RunFolder.written} holds the new run"
-    elif RunFolder.abandoned:
-        what = f"{RunFolder.abandoned} unchanged"
+    """One line, exit 128 + signal: what the run folder holds now. Nothing is imported here: an
+    interrupt inside an import leaves that module half-initialised, and importing it again can
+    print C-level warnings of its own (the decimal module's libmpdec does); without the output
+    module loaded, no run folder was touched."""
+    output = sys.modules.get("gearcheck.output")
+    run_folder = getattr(output, "RunFolder", None)
+    if run_folder is not None and run_folder.written:  # the new run was swapped in before the interrupt took effect
+        what = f"{run_folder.written} holds the new run"
+    elif run_folder is not None and run_folder.abandoned:
+        what = f"{run_folder.abandoned} unchanged"
     else:
         what = "nothing written"
     with contextlib.suppress(OSError):

@@ -59,41 +59,67 @@ class Certificate:
 
 def certify(xs: Sequence[float], cs: Sequence[float], measure: Callable[[float], float],
             displacement: Callable[[float, float], float], requirement: float, resolution: float,
-            max_measurements: int = 10_000) -> Certificate:
+            max_measurements: int = 10_000, precision: float = math.inf, sharpen: int = 0) -> Certificate:
     """Certify a requirement (clearance ≥ ``requirement``) over the motion through the poses ``xs``
     with measured clearances ``cs``; ``measure(x)`` measures at a new coordinate, ``displacement(a,
     b)`` bounds the path of any point over [a, b]. Intervals whose ends already fail are not
     refined (a sample fails the requirement by itself); a piece is split while its bound is below
     the requirement and its δ above ``resolution``, at most ``max_measurements`` new measurements in
-    all (then the rest is left undecided)."""
+    all (then the rest is left undecided).
+
+    Then, with ``sharpen`` > 0, the figure itself: the piece holding the certified minimum is split
+    (at most ``sharpen`` more measurements) while its bound lies more than ``precision`` below the
+    least clearance measured at its ends, so that the bound reported is close to the true least
+    clearance, not only on the right side of the requirement. Clearances may be given as ``inf``
+    only where no measurement is finite (callers give a finite lower bound, say a reach)."""
     cert = Certificate(requirement)
     if not len(xs):
         return cert
     cert.sampled_min = float(min(cs))
     stack = [(float(xs[i]), float(xs[i + 1]), float(cs[i]), float(cs[i + 1])) for i in range(len(xs) - 1)]
     stack.reverse()  # in motion order
-    done: list[tuple[float, float, float]] = []
+    done: list[tuple[float, float, float, float, float, float]] = []  # (x0, x1, bound, c0, c1, δ)
     if len(xs) == 1:
-        done.append((float(xs[0]), float(xs[0]), float(cs[0])))
-    while stack:
-        x0, x1, c0, c1 = stack.pop()
-        delta = displacement(x0, x1)
-        bound = interval_bound(c0, c1, delta)
-        ends_pass = min(c0, c1) >= requirement
-        if bound >= requirement or not ends_pass:
-            done.append((x0, x1, bound))
-            continue
-        if delta <= resolution or cert.refined >= max_measurements:
-            cert.undecided.append((x0, x1, bound))
-            done.append((x0, x1, bound))
-            continue
+        done.append((float(xs[0]), float(xs[0]), float(cs[0]), float(cs[0]), float(cs[0]), 0.0))
+
+    def split(x0: float, x1: float, c0: float, c1: float) -> None:
         xm = 0.5 * (x0 + x1)
         cm = float(measure(xm))
         cert.refined += 1
         cert.sampled_min = min(cert.sampled_min, cm)
         stack.append((xm, x1, cm, c1))
         stack.append((x0, xm, c0, cm))
-    x0, x1, bound = min(done, key=lambda d: d[2])
+
+    def settle() -> None:
+        while stack:
+            x0, x1, c0, c1 = stack.pop()
+            delta = displacement(x0, x1)
+            bound = interval_bound(c0, c1, delta)
+            ends_pass = min(c0, c1) >= requirement
+            if bound >= requirement or not ends_pass:
+                done.append((x0, x1, bound, c0, c1, delta))
+                continue
+            if delta <= resolution or cert.refined >= max_measurements:
+                cert.undecided.append((x0, x1, bound))
+                done.append((x0, x1, bound, c0, c1, delta))
+                continue
+            split(x0, x1, c0, c1)
+
+    settle()
+    extra = 0
+    while extra < sharpen:
+        worst = min(range(len(done)), key=lambda k: done[k][2])
+        x0, x1, bound, c0, c1, delta = done[worst]
+        if min(c0, c1) - bound <= precision or delta <= resolution or x1 <= x0:
+            break
+        done.pop(worst)
+        split(x0, x1, c0, c1)
+        extra += 1
+        settle()  # both halves decided again
+    if extra:  # the undecided pieces that were split are no longer pieces
+        pieces = {(d[0], d[1]) for d in done}
+        cert.undecided = [u for u in cert.undecided if (u[0], u[1]) in pieces]
+    x0, x1, bound = min(done, key=lambda d: d[2])[:3]
     cert.certified_min, cert.at = bound, (x0, x1)
     return cert
 

@@ -156,6 +156,10 @@ def _pushed_apart(scene: CountedScene, name: str, other: str, pose: np.ndarray, 
 
 
 NEWTON_STEPS = 4  # distance queries at most per contact estimate
+EXTRAPOLATION_MEMORY = 4  # the last poses a line is fitted to, for the next pose's estimate
+EXTRAPOLATION_MARGIN_TOL = 1.5  # the least margin, in bisection tolerances
+FIRST_MARGIN_TOL = 8.0  # the margin around the last pose's move alone, in bisection tolerances
+WIDER = 8.0  # a second try around the same extrapolation: its margin this many times wider
 NEWTON_DAMPING = (0.6, 0.9, 0.95)  # each step goes this share of the predicted way (a first one runs long)
 
 
@@ -207,21 +211,37 @@ def _newton(scene: CountedScene, spec: Spec, part: str, x: float, sign: float, a
     return free + step, max(tol, step)
 
 
-def _extrapolated(history: list[float], tol: float) -> tuple[float, float] | None:
+def _extrapolated(history: list[float], tol: float, widen: float = 1.0) -> tuple[float, float] | None:
     """(estimate, margin) of the next pose's move from the last poses' (the motion's poses are
-    close: the contact moves little from one to the next), or None without two of them."""
-    if len(history) < 2 or not all(math.isfinite(h) and h > 0.0 for h in history[-2:]):
+    close: the contact moves little from one to the next), or None without one. With
+    :data:`EXTRAPOLATION_MEMORY` of them, a straight line fitted to them (the moves are bisection
+    brackets, each rounded by up to one tolerance: the fit averages that out), its margin from how
+    far the fitted points lie off the line; with fewer, the line through the last two, its margin
+    their difference; with one, that move, its margin :data:`FIRST_MARGIN_TOL` tolerances. Each
+    margin times ``widen`` (a second try after the first estimate failed to prove its bracket)."""
+    recent = history[-EXTRAPOLATION_MEMORY:]
+    if not history or not (math.isfinite(history[-1]) and history[-1] > 0.0):
         return None
-    last, before = history[-1], history[-2]
-    return last + (last - before), max(2.0 * tol, abs(last - before))
+    if len(history) < 2 or not (math.isfinite(history[-2]) and history[-2] > 0.0):
+        return history[-1], widen * FIRST_MARGIN_TOL * tol
+    if len(recent) < EXTRAPOLATION_MEMORY or not all(math.isfinite(h) and h > 0.0 for h in recent):
+        last, before = history[-1], history[-2]
+        return last + (last - before), widen * max(2.0 * tol, abs(last - before))
+    k = np.arange(len(recent), dtype=float)
+    slope, offset = np.polyfit(k, np.asarray(recent, float), 1)
+    off = float(np.abs(offset + slope * k - np.asarray(recent, float)).max())
+    return float(offset + slope * len(recent)), widen * max(EXTRAPOLATION_MARGIN_TOL * tol, 2.0 * off + tol)
 
 
 def _to_contact(hits_at: Callable[[float], bool], tol: float, limit: float,
-                estimates: tuple[Callable[[], tuple[float, float] | None], ...]) -> float:
+                estimates: tuple[Callable[[], tuple[float, float] | None], ...],
+                known: dict[float, bool] | None = None) -> float:
     """The touching end of the bracket the plain bisection of [0, limit] ends with (``limit`` where
     nothing touches within it), found around the first estimate that proves its bracket (each an
-    (estimate, margin) or None, tried in order, answers shared), else by that bisection."""
+    (estimate, margin) or None, tried in order, answers shared), else by that bisection. ``known``:
+    answers already had (the pose itself, say: free)."""
     ask, asked = remembered(hits_at)
+    asked.update(known or {})
     for make in estimates:
         estimate = make()
         if estimate is None or not 0.0 < estimate[0] < limit:
@@ -233,13 +253,15 @@ def _to_contact(hits_at: Callable[[float], bool], tol: float, limit: float,
 
 
 def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bool,
-          history: tuple[list[float], list[float]] = ([], [])) -> tuple[float, float, float, float]:
+          history: tuple[list[float], list[float]] = ([], []), free: bool = False) -> tuple[float, float, float, float]:
     """(plus, minus) moves of the play part from its coupled position to contact with any of its
     neighbours, the others held (a part already in contact, ``overlapping`` at the pose: the
     negative clearing move), and the index of the neighbour touched at each (NaN: none within the
-    limit). Each move is the bracket the plain bisection of [0, limit] ends with, found with few
-    collisions around a Newton estimate (:func:`_newton`; the bracket proven from both sides),
-    else by the plain bisection."""
+    limit); ``free``: every pair of the part was found apart at this pose (not asked again). Each
+    move is the bracket the plain bisection of [0, limit] ends with, found with few collisions
+    around an estimate (the last poses' moves extrapolated, then with a wider margin, then Newton
+    steps on the gap, :func:`_newton`; the bracket proven from both sides), else by the plain
+    bisection."""
     part = spec.play
     assert part is not None
     line = spec.kin.lines[part]
@@ -279,7 +301,9 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
             # the last poses' moves extrapolated (collisions only), else Newton steps on the gap
             move = _to_contact(hits_at, tol, limit, (
                 functools.partial(_extrapolated, past, tol),
-                functools.partial(_newton, scene, spec, part, x, sign, ahead, facing, tol, limit)))
+                functools.partial(_extrapolated, past, tol, WIDER),
+                functools.partial(_newton, scene, spec, part, x, sign, ahead, facing, tol, limit)),
+                known={0.0: False} if free else None)
             at = move
         who = None
         if move < limit and len(near) == 1:
@@ -319,6 +343,13 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     them, where pairs that do not move relative to each other are checked), and each moving pair's
     clearance certified over the motion from the first of them to the pose ``after`` (the next
     task's first, measured here too, not recorded: every interval is certified by one task)."""
+    live = [r for r in spec.pairs if r.key not in spec.far]
+    names = {spec.mesh(r, p, state) for r in live for p in (r.a, r.b)}
+    if spec.play:  # the play part's directed meshes too: BVHs are built here, not in a measurement's time
+        suffix = "" if state == AS_BUILT else f"@{state}"
+        names |= {n + suffix for (other, _), pair in spec.play_meshes.items()
+                  if spec.rule(spec.play, other).key not in spec.far for n in pair}
+    scene.build(sorted(names))
     scene = CountedScene(scene)
     kin = spec.kin
     n, m = len(indices), len(spec.pairs)
@@ -329,7 +360,6 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     play = np.full((n, 4), np.nan)  # plus, minus, neighbour touched plus, minus
     start = time.perf_counter()
     play_s: list[float] = []  # one play measurement (both ways) per pose
-    live = [r for r in spec.pairs if r.key not in spec.far]
     for row, i in enumerate(indices):
         x = float(kin.coordinates[i])
         scene.set_poses({spec.mesh(r, p, state): kin.pose(p, x) for r in live for p in (r.a, r.b)})
@@ -346,9 +376,10 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
                 points[row, k] = np.concatenate([d.point_a, d.point_b])
         if spec.play:
             t0 = time.perf_counter()
-            hit = any(np.isfinite(overlap_mm[row, k]) or np.isinf(overlap_mm[row, k])
-                      for k, r in enumerate(spec.pairs) if spec.play in (r.a, r.b) and r.key not in spec.far)
-            play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])))
+            mine = [k for k, r in enumerate(spec.pairs) if spec.play in (r.a, r.b) and r.key not in spec.far]
+            hit = any(np.isfinite(overlap_mm[row, k]) or np.isinf(overlap_mm[row, k]) for k in mine)
+            free = all(clearance[row, k] > 0.0 for k in mine)  # each asked at this pose, and apart
+            play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])), free)
             play_s.append(time.perf_counter() - t0)
     certificates: dict[str, dict] = {}
     for k, rule in enumerate(spec.pairs):

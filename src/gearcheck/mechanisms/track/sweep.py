@@ -39,6 +39,7 @@ from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.track import GAP_CHECK_STEP_MM, analysis
 from gearcheck.mechanisms.track import wear as track_wear
 from gearcheck.mechanisms.track.assembly import LINK, SPROCKET, TrackModel
+from gearcheck.mechanisms.track.certified import TrackCertificates, certify_track, reach_xy
 from gearcheck.mechanisms.track.clearance import (CYCLE_MARGIN_FRACTION, STEPS_PER_CYCLE, exact_section,
                                                   exact_table, sweep_angles, worn_model)
 from gearcheck.results import SweepOutcome, WorstPose
@@ -127,6 +128,7 @@ class _Setup:
     started: float
     scene: Scene  # the reduce step's own (its contact proofs), built while the workers start
     worn_model: TrackModel | None = None  # the same chain re-wrapped at the declared worn pitch
+    link_bound: float = 0.0  # the link mesh's own error bound (mm)
 
 
 def link_names(assembly: Assembly) -> list[str]:
@@ -163,7 +165,7 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
         tasks += [(evaluate_pose, (worn, float(a))) for a in angles]
     scene = Scene(meshes)
     setup = _Setup(model, names, meshes, bound, max(CONTACT_TOLERANCE_MM, bound), angles, time.perf_counter(),
-                   scene, worn)
+                   scene, worn, bodies[names[0]].error_bound_mm)
     return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts, first=scene.build)
 
 
@@ -225,6 +227,7 @@ class TrackSweep:
     proof_s: float
     wear: track_wear.WearLimit | None = None  # the chain-wear limit (exact 2-D model), see :mod:`.wear`
     worn_mesh: WornMesh | None = None  # the mesh sweep of the chain at the declared worn pitch
+    certified: TrackCertificates | None = None  # both figures over the continuous motion (:mod:`.certified`)
 
     @property
     def collisions(self) -> int:
@@ -342,6 +345,32 @@ def _worn_mesh(results: list, exact: np.ndarray | None, reach_mm: float) -> Worn
                     float(ex_sleeve.min()), float(ex_plate.min()), float(max(dev_sleeve.max(), dev_plate.max())))
 
 
+def _certify(setup: _Setup, sleeve_d: np.ndarray, plate_d: np.ndarray, table: np.ndarray) -> TrackCertificates:
+    """Both figures of every link certified over the continuous motion (:mod:`.certified`), on the
+    meshes (distance queries in this process where an interval does not decide) and on the exact
+    2-D model; the requirements: no interference for the sleeve, the least tip gap for the plate,
+    each at report precision (as the verdicts read them: to half of :data:`WINDOW_ROUNDING_MM`),
+    the exact model refined down to that too."""
+    model, scene, angles = setup.model, setup.scene, setup.angles
+    exact = exact_section(model)
+    wrap = model.wrap
+    names = (SLEEVE, PLATE)
+
+    def mesh_measure(figure: int, link: int, a: float) -> float:
+        scene.set_pose(SPROCKET, tc.sprocket_matrix(a))
+        scene.set_pose(names[figure], wrap.link_matrices(a)[link])
+        return scene.distance(SPROCKET, names[figure]).distance
+
+    def exact_measure(figure: int, link: int, a: float) -> float:
+        return exact.link_distances(tc.sprocket_matrix(a), wrap.link_matrices(a)[link])[figure]
+
+    reach = (reach_xy(setup.meshes[1].vertices), reach_xy(setup.meshes[2].vertices))
+    return certify_track(wrap, angles, (sleeve_d, plate_d), (table[..., 0], table[..., 1]),
+                         model.required_gap_min_mm, mesh_measure, exact_measure, reach,
+                         (setup.bound, 0.5 * WINDOW_ROUNDING_MM), exact.reach_mm, setup.link_bound,
+                         0.5 * WINDOW_ROUNDING_MM)
+
+
 def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     """Extremes over all poses and links, contact proofs at the worst poses, the summary, the
     worst poses for exact confirmation and the smallest clearance decided on."""
@@ -371,6 +400,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     seated_gap_max = float(np.where(links_seated, plate_d, -np.inf).max())
 
     pr = _proofs(setup, x, sleeve_seated)
+    certified = _certify(setup, sleeve_d, plate_d, table)
     min_sleeve, min_plate = x["min_sleeve"], x["min_plate"]
     s_sl, pose_sl, s_pl, pose_pl = pr["s_sl"], pr["pose_sl"], pr["s_pl"], pr["pose_pl"]
     gap_proof, sleeve_proof, gap_point_link = pr["gap_proof"], pr["sleeve_proof"], pr["gap_point_link"]
@@ -384,7 +414,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
                       gap_point_link, float(whole_link_at_sleeve), model_gap, len(setup.meshes[1].faces),
                       len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s,
                       wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation, tables=tables),
-                      worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm))
+                      worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm), certified=certified)
     worst = [
         WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
                   names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),
@@ -393,7 +423,8 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     ]
     swept = len(results)  # sprocket poses swept: the new chain's and, where declared, the worn chain's
     timings = {"sweep_s": sweep_s, "sprocket_poses": swept, "poses_per_s": swept / sweep_s,
-               "link_poses_per_s": swept * wrap.links / sweep_s, "contact_proof_s": proof_s}
+               "link_poses_per_s": swept * wrap.links / sweep_s, "contact_proof_s": proof_s,
+               "certify_s": certified.seconds}
     return SweepOutcome(summary(data), worst, timings, data)
 
 
@@ -461,6 +492,7 @@ def summary(d: TrackSweep) -> dict:
         "min_at_seated_links": int(x["ex_off_plate"].value >= x["ex_seated_gap"].value - WINDOW_ROUNDING_MM
                                    and x["ex_off_sleeve"].value >= x["ex_seated_sleeve"].value - WINDOW_ROUNDING_MM),
         **({} if d.wear is None else wear_summary(d.wear, d.worn_mesh, d.bound)),
+        **({} if d.certified is None else {"certified": d.certified.summary()}),
     }
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from gearcheck.mechanisms.track.certified import CERTIFIED, decided
 from gearcheck.mechanisms.track.sweep import WINDOW_ROUNDING_MM, TrackSweep
 from gearcheck.mechanisms.track.wear import MODE_TEXT
 from gearcheck.results import SweepOutcome, Verdict
@@ -25,16 +26,25 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     gap_proof, sleeve_proof = d.gap_proof, d.sleeve_proof
     collisions, angles = d.collisions, d.angles
 
-    exact_penetration = min(ex_min_sleeve.value, ex_min_plate.value) < 0.0
     # a mesh collision at a clearance the meshes cannot resolve is not evidence: the exact model decides
     resolved = outcome.mesh_resolves
-    no_interference = (collisions == 0 or not resolved) and not exact_penetration
+    cert = d.certified
+    if cert is not None:  # every figure over the continuous motion, not only at the swept angles
+        free, cert_sleeve, cert_plate = cert.interference_free(resolved)
+        exact_least = min(cert.exact_sleeve.certified_min,
+                          (cert.exact_plate_touch or cert.exact_plate).certified_min)
+        least_plate = decided(cert.plate, cert.exact_plate, model.required_gap_min_mm - cert.slack_mm, resolved)
+    else:
+        free, cert_sleeve, cert_plate = True, min_sleeve.value, min_plate.value
+        exact_least, least_plate = min(ex_min_sleeve.value, ex_min_plate.value), min_plate.value
+    exact_penetration = rounded(exact_least) < 0.0
+    no_interference = (collisions == 0 or not resolved) and not exact_penetration and free
     on_mesh = ("mesh sweep (FCL at every link pose: distances, collide within 1 µm), exact 2-D model agrees"
                if resolved else "exact model (2-D section): the meshes cannot resolve the least clearance; "
                "exact B-rep at the worst poses")
     gap_in_window = (rounded(seated_gap.value) >= model.required_gap_min_mm
                      and rounded(d.seated_gap_max) <= model.required_gap_max_mm)
-    min_plate_ok = rounded(min_plate.value) >= model.required_gap_min_mm
+    min_plate_ok = rounded(least_plate) >= model.required_gap_min_mm
     proofs_hold = gap_proof.holds(bound) and sleeve_proof.holds(bound)
     worn_dev = d.worn_mesh.max_dev if d.worn_mesh is not None else 0.0
     agrees = max(d.max_dev, worn_dev) <= bound
@@ -43,9 +53,14 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
              "distance > 1 µm, else collide false); ")
     kind = ("a positive clearance beyond the bound" if min_sleeve.value > bound
             else "within the bound: a contact, not a resolved clearance")
-    least_exact = min(ex_min_sleeve.value, ex_min_plate.value)
     interference = (f"{collisions} colliding link poses" if collisions and resolved else "no mesh collision") + (
-        f"; the exact 2-D model overlaps by {-least_exact:.4f} mm, required ≥ 0" if exact_penetration else "")
+        f"; the exact 2-D model overlaps by {-exact_least:.4f} mm, required ≥ 0" if exact_penetration else "") + (
+        "" if free else f"; certified over the continuous motion: tooth–sleeve ≥ {cert_sleeve:.4f} mm, tip–plate ≥ "
+        f"{cert_plate:.4f} mm, required ≥ 0")
+    continuous = ("" if cert is None else f"; certified over the continuous motion: tooth–sleeve ≥ {cert_sleeve:.4f}, "
+                  f"tip–plate ≥ {cert_plate:.4f} mm")
+    plate_continuous = ("" if cert is None else f" (sampled; certified over the continuous motion ≥ "
+                        f"{least_plate:.4f} mm)")
     lo, hi = model.required_gap_min_mm, model.required_gap_max_mm
     gap_short = (f"seated tip gap {seated_gap.value:.4f} mm, required {lo:g}–{hi:g} mm, short by "
                  f"{lo - seated_gap.value:.4f} mm" if rounded(seated_gap.value) < lo else
@@ -56,10 +71,14 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     return [
         Verdict.of("no_interference", "no interference between sprocket and links over the sweep", no_interference,
                    clash + f"min tooth–sleeve {min_sleeve.value:.4f} mm ({kind}; exact "
-                   f"{ex_min_sleeve.value:.4f}), min tip–plate {min_plate.value:.4f} mm; bound {bound:.3f} mm",
+                   f"{ex_min_sleeve.value:.4f}), min tip–plate {min_plate.value:.4f} mm{continuous}; "
+                   f"bound {bound:.3f} mm",
                    {"collisions": collisions, "min_tooth_sleeve_mm": min_sleeve.value,
                     "exact_min_tooth_sleeve_mm": ex_min_sleeve.value, "min_tip_plate_mm": min_plate.value,
-                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound}, evidence=on_mesh,
+                    "exact_min_tip_plate_mm": ex_min_plate.value, "bound_mm": bound,
+                    **({} if cert is None else {"certified_min_tooth_sleeve_mm": cert_sleeve,
+                                                "certified_min_tip_plate_mm": cert_plate})},
+                   evidence=on_mesh + ("" if cert is None else "; " + CERTIFIED),
                    shortfall=interference),
         Verdict.of("seated_tip_gap_in_window", "seated-link tip gap inside the required window", gap_in_window,
                    f"{seated_gap.value:.4f}–{d.seated_gap_max:.4f} mm over {int(d.links_seated.sum())} seated link "
@@ -71,12 +90,15 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                    shortfall=gap_short),
         Verdict.of("min_tip_plate_distance", "tip-to-plate distance over the sweep ≥ the required minimum",
                    min_plate_ok,
-                   f"min {min_plate.value:.4f} mm at {d.where(min_plate)}, limit ≥ {model.required_gap_min_mm:g} mm; "
-                   f"bound {bound:.3f} mm",
-                   {"min_tip_plate_mm": min_plate.value, "limit_mm": model.required_gap_min_mm},
-                   evidence="mesh sweep (every link pose); exact 2-D model agrees",
-                   shortfall=f"least tip–plate distance {min_plate.value:.4f} mm, required ≥ {lo:g} mm, short by "
-                             f"{lo - min_plate.value:.4f} mm"),
+                   f"min {min_plate.value:.4f} mm at {d.where(min_plate)}{plate_continuous}, limit ≥ "
+                   f"{model.required_gap_min_mm:g} mm; bound {bound:.3f} mm",
+                   {"min_tip_plate_mm": min_plate.value, "limit_mm": model.required_gap_min_mm,
+                    **({} if cert is None else {"certified_min_tip_plate_mm": least_plate})},
+                   evidence="mesh sweep (every link pose); exact 2-D model agrees"
+                   + ("" if cert is None else "; " + CERTIFIED),
+                   shortfall=f"least tip–plate distance {least_plate:.4f} mm"
+                             + ("" if cert is None else " (certified over the continuous motion)")
+                             + f", required ≥ {lo:g} mm, short by {lo - least_plate:.4f} mm"),
         Verdict.of("contact_proven", "clearances proven from both sides (free at −tol, contact at +tol)", proofs_hold,
                    f"tip gap: contact at {gap_proof.contact_mm:.5f} mm vs measured {gap_proof.measured_mm:.5f}; "
                    f"seat: contact at {sleeve_proof.contact_mm:.5f} mm vs measured {sleeve_proof.measured_mm:.5f}; "

@@ -1,0 +1,251 @@
+"""The track's clearances certified over the continuous motion, not only at the swept angles.
+
+Between two sprocket angles θ0 < θ1 the sweep measures nothing; :mod:`gearcheck.sweep.certify`
+bounds each link's clearance there from its ends' clearances and the longest path any point of the
+link takes *relative to the sprocket* over the interval. The wrap (:class:`ChainWrap`) makes that
+path simple. In the sprocket's frame:
+
+* a seated pin does not move (it sits in its groove);
+* the entry run is a straight line of pins through the last seated pin with a fixed direction in
+  the world, so in the sprocket's frame the whole run turns rigidly about that pin by −(θ1 − θ0);
+  the exit run the same about the first seated pin; the link swinging in or out turns with its run
+  about that pin.
+
+So a link seated at both ends of the interval (then throughout: its grooves' polar angles move
+monotonically through the seated span) does not move at all, and any other link's points move at
+most |θ1 − θ0|·ρ, ρ the farthest any of its points lies from the pivot: the pivot-to-own-pin
+distance (a whole number of pitches along the run) plus the farthest point of the link from its own
+pin axis in the plane. A seating within the interval changes the pivot; each piece of the motion
+is a turn about its own pivot, so the largest ρ over the pivots of both ends (and those between)
+bounds the whole path.
+
+Each link's two figures (tooth–sleeve clearance, tip-to-plate distance) are certified over the
+swept range on the meshes (distance queries in the reducing process where an interval does not
+decide) and on the exact 2-D model (which also decides the intervals too short for the meshes to
+resolve). The refinement stops at each model's own error: the meshes' error bound, the exact
+outline's sagitta.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from gearcheck.geometry import track_chain as tc
+from gearcheck.sweep.certify import Certificate, certify
+
+# The figures, their index in the sweep's (and the exact table's) last axis.
+SLEEVE_FIGURE, PLATE_FIGURE = 0, 1
+# Each figure's certified minimum is sharpened to this (mm) below the least measured clearance
+# beside it (report precision), with at most SHARPEN more measurements per figure.
+PRECISION_MM = 1e-4
+SHARPEN = 48
+SHARPEN_LINKS = 3  # links sharpened at most, per figure
+# How a verdict read from the certificates names its evidence.
+CERTIFIED = ("certified over the continuous motion (each interval between swept angles bounded by its ends' "
+             "clearances and the longest path of a link point relative to the sprocket, refined by distance "
+             "queries; the exact 2-D model decides the intervals too short for the meshes)")
+
+
+def _events(wrap: tc.ChainWrap, a0: float, a1: float) -> list[float]:
+    """The drive angles inside (a0, a1) where a pin seats or leaves its groove (its groove's polar
+    angle crosses ψ_in − β/2 or ψ_out + β/2)."""
+    beta, two_pi = wrap.cycle_rad, 2.0 * math.pi
+    lo = wrap.entry_angle_rad - beta / 2.0
+    edges = (lo, wrap.exit_angle_rad + beta / 2.0)
+    out = []
+    for k in wrap.pin_grooves():
+        offset = two_pi * float(k) / wrap.teeth
+        for edge in edges:  # θ = edge − offset + 2πn
+            base = edge - offset
+            n = math.ceil((a0 - base) / two_pi)
+            while base + n * two_pi < a1:
+                if base + n * two_pi > a0:
+                    out.append(base + n * two_pi)
+                n += 1
+    return sorted(out)
+
+
+def link_path_mm(wrap: tc.ChainWrap, link: int, a0: float, a1: float, reach_mm: float,
+                 round_mm: float | None = None) -> float:
+    """The longest path (mm) any point of link ``link`` takes relative to the sprocket while the
+    drive turns from ``a0`` to ``a1`` (rad); ``reach_mm``: the farthest point of the link (or of the
+    part of it certified) from its own pin axis, in the plane. The interval is cut where a pin seats
+    or leaves (:func:`_events`); on each piece the link stands still (seated) or turns with its run
+    about the run's seated pin.
+
+    ``round_mm``: the part is round about its own pin axis (the sleeve) to within this (mm; 0 for
+    the exact circle, the tessellation's error for a mesh): where it turns about that very axis (the
+    link swinging in about its seated pin) its points move but the part does not — it stays within
+    ``round_mm`` of itself, which counts as a path of 2·round_mm (c ≥ c_end − round_mm, a weaker
+    use of the same bound)."""
+    lo, hi = sorted((a0, a1))
+    cuts = [lo, *_events(wrap, lo, hi), hi]
+    p = wrap.pitch_mm
+    path, turns_round = 0.0, False
+    for b0, b1 in zip(cuts[:-1], cuts[1:], strict=True):
+        if not b1 > b0:
+            continue
+        seated = wrap.seated_pins(0.5 * (b0 + b1))
+        if seated[link] and seated[link + 1]:
+            continue
+        idx = np.flatnonzero(seated)
+        first, last = int(idx[0]), int(idx[-1])
+        rho = (link - last) * p if link >= last else (first - link) * p  # to the run's pivot pin
+        if rho == 0.0 and round_mm is not None:
+            turns_round = True
+        else:
+            path += (b1 - b0) * (rho + reach_mm)
+    return path + (2.0 * round_mm if turns_round and round_mm is not None else 0.0)
+
+
+@dataclass
+class FigureCertificate:
+    """One figure over every link: the least certified bound, where (link, angle interval in rad),
+    the least measured value, the refinements, and the intervals left undecided (link, a0, a1)."""
+
+    certified_min: float = math.inf
+    sampled_min: float = math.inf
+    link: int = -1
+    between_rad: tuple[float, float] = (math.nan, math.nan)
+    refined: int = 0
+    undecided: list[tuple[int, float, float]] = field(default_factory=list)
+
+    def as_dict(self, prefix: str) -> dict:
+        return {f"{prefix}certified_min_mm": self.certified_min, f"{prefix}sampled_min_mm": self.sampled_min,
+                f"{prefix}certified_min_link": self.link,
+                f"{prefix}certified_min_between_deg": [math.degrees(a) for a in self.between_rad],
+                f"{prefix}intervals_refined": self.refined, f"{prefix}undecided_intervals": len(self.undecided)}
+
+
+def certify_figure(wrap: tc.ChainWrap, angles: np.ndarray, values: np.ndarray, requirement: float,
+                   measure: Callable[[int, float], float], reach_mm: float, resolution_mm: float,
+                   floor_mm: float, round_mm: float | None = None) -> FigureCertificate:
+    """One figure (``values[:, link]`` at ``angles``) certified for every link: clearance ≥
+    ``requirement`` over the continuous motion, refined by ``measure(link, angle)``; a value that
+    is not finite (nothing within the model's reach) counts as ``floor_mm``, a lower bound of it.
+    Then the figure itself is sharpened: the link holding the least bound is certified again with
+    its least piece split to :data:`PRECISION_MM` (the next link's, if it then holds the least)."""
+    xs = [float(a) for a in angles]
+    refined, sampled = 0, math.inf
+
+    def run(link: int, sharpen: int) -> Certificate:
+        nonlocal refined, sampled
+        cs = [_finite(v, floor_mm) for v in values[:, link]]
+        cert = certify(xs, cs, lambda x: _finite(measure(link, x), floor_mm),
+                       lambda a0, a1: link_path_mm(wrap, link, a0, a1, reach_mm, round_mm), requirement,
+                       resolution_mm,
+                       precision=PRECISION_MM, sharpen=sharpen)
+        refined += cert.refined
+        sampled = min(sampled, cert.sampled_min)
+        return cert
+
+    certs = {link: run(link, 0) for link in range(values.shape[1])}
+    sharpened: set[int] = set()
+    while True:
+        worst = min(certs, key=lambda k: certs[k].certified_min)
+        if worst in sharpened or len(sharpened) >= SHARPEN_LINKS:
+            break
+        sharpened.add(worst)
+        certs[worst] = run(worst, SHARPEN)
+    out = FigureCertificate(refined=refined, sampled_min=sampled)
+    for link, cert in certs.items():
+        out.undecided += [(link, u[0], u[1]) for u in cert.undecided]
+    out.link = worst
+    out.certified_min, out.between_rad = certs[worst].certified_min, certs[worst].at
+    return out
+
+
+def _finite(v: float, floor: float) -> float:
+    return float(v) if math.isfinite(v) else floor
+
+
+def reach_xy(vertices: np.ndarray) -> float:
+    """The farthest vertex from the link's own pin axis (the link frame's z axis), in the plane."""
+    return float(np.hypot(vertices[:, 0], vertices[:, 1]).max())
+
+
+@dataclass(frozen=True)
+class TrackCertificates:
+    """Both figures certified on the meshes and on the exact 2-D model, each against its own
+    requirement (the sleeve: no interference; the plate: the least tip gap) and, where a swept
+    plate distance falls short of the least tip gap, the plate again against no interference
+    (``*_touch``: the first certificate leaves the intervals of a failing end unrefined)."""
+
+    sleeve: FigureCertificate
+    plate: FigureCertificate
+    exact_sleeve: FigureCertificate
+    exact_plate: FigureCertificate
+    seconds: float
+    plate_touch: FigureCertificate | None = None
+    exact_plate_touch: FigureCertificate | None = None
+    slack_mm: float = 0.0  # a requirement holds to within this (half the report precision)
+
+    def summary(self) -> dict:
+        out = {**self.sleeve.as_dict("sleeve_"), **self.plate.as_dict("plate_"),
+               **self.exact_sleeve.as_dict("exact_sleeve_"), **self.exact_plate.as_dict("exact_plate_")}
+        for name, f in (("plate_touch_", self.plate_touch), ("exact_plate_touch_", self.exact_plate_touch)):
+            if f is not None:
+                out.update(f.as_dict(name))
+        return {**out, "seconds": self.seconds}
+
+    def interference_free(self, resolved: bool) -> tuple[bool, float, float]:
+        """(no interference over the continuous motion, the least certified sleeve clearance and
+        plate distance the decision read): each figure's certified bound on the meshes, and where
+        the meshes leave intervals too short to decide (or cannot resolve the clearance at all) the
+        exact model's; the exact model's bound must hold too."""
+        plate = self.plate_touch or self.plate
+        exact_plate = self.exact_plate_touch or self.exact_plate
+        floor = -self.slack_mm
+        sleeve_v = decided(self.sleeve, self.exact_sleeve, floor, resolved)
+        plate_v = decided(plate, exact_plate, floor, resolved)
+        ok = min(sleeve_v, plate_v, self.exact_sleeve.certified_min, exact_plate.certified_min) >= floor
+        return ok, sleeve_v, plate_v
+
+
+def decided(mesh: FigureCertificate, exact: FigureCertificate, requirement: float, resolved: bool = True) -> float:
+    """The least value over the continuous motion a verdict on ``requirement`` reads: the meshes'
+    certified bound where it decides; where it does not but no swept pose fails (its failing
+    intervals are those too short for the meshes to resolve) or the meshes cannot resolve the
+    clearance at all, the exact model's certified bound."""
+    if mesh.certified_min >= requirement:
+        return mesh.certified_min
+    if not resolved or mesh.sampled_min >= requirement:
+        return exact.certified_min
+    return mesh.certified_min
+
+
+def certify_track(wrap: tc.ChainWrap, angles: np.ndarray, mesh: tuple[np.ndarray, np.ndarray],
+                  exact: tuple[np.ndarray, np.ndarray], least_gap_mm: float,
+                  mesh_measure: Callable[[int, int, float], float], exact_measure: Callable[[int, int, float], float],
+                  reach_mm: tuple[float, float], resolution_mm: tuple[float, float], floor_mm: float,
+                  link_error_mm: float, slack_mm: float = 0.0) -> TrackCertificates:
+    """The tooth–sleeve clearance (against 0) and the tip-to-plate distance (against
+    ``least_gap_mm``) of every link certified over the swept range: on the meshes (``mesh`` =
+    (sleeve, plate) values per angle and link, refined by ``mesh_measure(figure, link, angle)``, to
+    ``resolution_mm[0]``) and on the exact model (to ``resolution_mm[1]``); ``reach_mm``: each
+    figure's part of the link, its farthest point from the pin axis; ``link_error_mm``: the link
+    mesh's own error bound (how far its sleeve is from round); ``slack_mm``: a requirement holds
+    to within this (the verdicts compare at report precision: half of it)."""
+    import time
+
+    t0 = time.perf_counter()
+    out: dict[str, FigureCertificate] = {}
+    for label, values, measure, resolution in (("", mesh, mesh_measure, resolution_mm[0]),
+                                               ("exact_", exact, exact_measure, resolution_mm[1])):
+        def run(figure: int, requirement: float, measure=measure, values=values, resolution=resolution,
+                label=label) -> FigureCertificate:
+            # the sleeve is round about its pin: the model's own error (the exact circle: none)
+            round_mm = (link_error_mm if label == "" else 0.0) if figure == SLEEVE_FIGURE else None
+            return certify_figure(wrap, angles, values[figure], requirement,
+                                  lambda link, a: measure(figure, link, a), reach_mm[figure], resolution, floor_mm,
+                                  round_mm)
+
+        out[f"{label}sleeve"] = run(SLEEVE_FIGURE, -slack_mm)
+        out[f"{label}plate"] = run(PLATE_FIGURE, least_gap_mm - slack_mm)
+        if out[f"{label}plate"].sampled_min < least_gap_mm - slack_mm and least_gap_mm > 0.0:
+            out[f"{label}plate_touch"] = run(PLATE_FIGURE, -slack_mm)
+    return TrackCertificates(seconds=time.perf_counter() - t0, slack_mm=slack_mm, **out)
