@@ -20,7 +20,8 @@ sprocket poses/s over the sweep's wall time; the worker pool's speed-up from 1 t
 to every core). Written to ``--out`` with the ratios (current / baseline) and each target's met
 flag; the study section (bench/study.py) and the assembly section (bench/assembly.py: an assembly's
 sweep against the native mechanism's on the same poses, a 10⁶-triangle file) measure the current
-code only.
+code only; the certify section (bench/certify.py) sets the templates' sweeps beside the commit
+before they were certified over the continuous motion.
 
 Speed targets live here, never in timed tests.
 """
@@ -482,6 +483,26 @@ def assembly_section() -> dict[str, Any]:
     return _section("assembly", "bench_assembly", "assembly")
 
 
+def certify_section() -> dict[str, Any]:
+    """bench/certify.py: the three templates' sweeps on one worker, the commit before the certified
+    sweeps against the current code, side by side (CPU seconds)."""
+    return _section("certify", "bench_certify", "certify")
+
+
+def _sections(result: dict[str, Any], args: argparse.Namespace) -> None:
+    """The sections beside the side-by-side figures (each written out as soon as it is done)."""
+    if not (args.quick or args.skip_study):
+        log("study section (current code) ...")
+        result["study"] = study_section()
+    if not args.quick:
+        log("assembly section (current code) ...")
+        result["assembly"] = assembly_section()
+        write_json(args.out, result)
+        log("certify section (the commit before the certified sweeps against the current code) ...")
+        result["certify"] = certify_section()
+        write_json(args.out, result)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path, default=ROOT / "out" / "bench.json")
@@ -521,20 +542,14 @@ def main(argv: list[str] | None = None) -> int:
     result["targets"] = targets
     result["side_by_side_s"] = time.perf_counter() - t_start
     write_json(args.out, result)
-    if not (args.quick or args.skip_study):
-        log("study section (current code) ...")
-        result["study"] = study_section()
-    if not args.quick:
-        log("assembly section (current code) ...")
-        result["assembly"] = assembly_section()
-        write_json(args.out, result)
+    _sections(result, args)
     result["machine"]["loadavg_end"] = list(os.getloadavg())
     result["total_s"] = time.perf_counter() - t_start
     write_json(args.out, result)
     print(table(targets, cur, base, n_cores))
-    for name, fig in (result.get("assembly") or {}).items():
+    for name, fig in {**(result.get("assembly") or {}), **(result.get("certify") or {})}.items():
         if isinstance(fig, dict) and "target" in fig:
-            print(f"assembly, {name.replace('_', ' ')}: {'met' if fig['met'] else 'NOT met'} ({fig['target']}): "
+            print(f"{name.replace('_', ' ')}: {'met' if fig['met'] else 'NOT met'} ({fig['target']}): "
                   + ", ".join(f"{k} {v:.4g}" for k, v in fig.items() if isinstance(v, float)))
     met = sum(t["met"] for t in targets)
     print(f"\n{met}/{len(targets)} targets met; baseline {args.baseline}, current {current.commit[:12]}"

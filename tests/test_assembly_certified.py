@@ -54,3 +54,36 @@ def test_a_closest_approach_between_two_samples_is_caught(tmp_path):
     summary = json.loads((run.folder / "summary.json").read_text())["assembly"]
     assert summary["verdict_levels"]["clearance_bar__post"] == "fail"
     assert not run.passed and math.isfinite(pair["certified_min_mm"])
+
+
+def test_the_interval_path_bounds_every_mesh_points_path(build_bodies):
+    """interval_path (the relative speed on the pruned meshes' convex hulls, grown along each
+    point's own path) is never below the path any vertex of the pair's pruned meshes takes relative
+    to the other part, sampled finely, and not far above it."""
+    import numpy as np
+
+    from gearcheck.mechanism import get
+    from gearcheck.mechanisms.assembly.sweep import interval_path
+
+    run = build_bodies("assembly_spur_pair")
+    plan = get("assembly").plan(run.design.params, run.assembly, run.bodies, None)
+    spec = plan.tasks[0][1][0]
+    meshes = {m.name: m for m in plan.meshes}
+    rule = next(r for r in spec.pairs if r.key not in spec.far and r.moving)
+    names = spec.meshes[rule.key]
+    kin = spec.kin
+    rng = np.random.default_rng(5)
+    x_lo, x_hi = float(kin.coordinates[0]), float(kin.coordinates[-1])
+    for _ in range(12):
+        x0 = float(rng.uniform(x_lo, x_hi))
+        x1 = x0 + float(rng.uniform(0.0, 0.2 * (x_hi - x_lo)))
+        xs = np.linspace(x0, x1, 200)
+        paths = []
+        for part, other, name in ((rule.a, rule.b, names[0]), (rule.b, rule.a, names[1])):
+            v = meshes[name].vertices
+            placed = np.stack([(np.linalg.inv(kin.pose(other, x)) @ kin.pose(part, x))[:3] @ np.c_[v, np.ones(len(v))].T
+                               for x in xs])  # (steps, 3, n): the vertices in the other part's frame
+            paths.append(float(np.linalg.norm(np.diff(placed, axis=0), axis=1).sum(axis=0).max()))
+        bound = interval_path(spec, rule, x0, x1)
+        assert min(paths) <= bound * (1 + 1e-9) + 1e-12
+        assert bound <= 1.5 * max(paths) + 1e-9

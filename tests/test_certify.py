@@ -76,3 +76,27 @@ def test_sharpening_brings_the_figure_to_the_true_least_clearance():
     assert sharp.certified_min <= 0.2 + 1e-12  # still a lower bound of the true least clearance ...
     assert sharp.certified_min == pytest.approx(0.2, abs=2e-3)  # ... and close to it
     assert loose.refined < sharp.refined <= loose.refined + 400
+
+
+def _dip(x):
+    x = np.asarray(x, float)
+    return 1.0 - 0.3 * np.maximum(0.0, 1.0 - np.abs(np.mod(x, 1.0) - 0.37) / 0.2) + 0.05 * np.sin(2 * np.pi * x)
+
+
+def test_the_least_of_a_cycle_is_refined_to_its_precision():
+    from gearcheck.sweep.certify import refine_least
+
+    xs = [0.0, 1 / 3, 2 / 3]  # three samples per cycle: the dip at 0.37 lies between two of them
+    fine = np.linspace(0.0, 1.0, 300, endpoint=False)  # 100× finer
+    calls = []
+
+    def evaluate(points):
+        calls.append(len(points))
+        return _dip(points)
+
+    r = refine_least(xs, _dip(xs), evaluate, 1.0, precision=1e-4)
+    true = float(_dip(np.linspace(0.0, 1.0, 200001)).min())
+    assert min(_dip(xs)) - true > 0.05  # the samples alone miss it by far
+    assert r.least == pytest.approx(true, abs=1e-4)
+    assert r.lower <= true <= r.least and r.lower <= float(_dip(fine).min()) and r.bracket <= 1e-4
+    assert r.refined == sum(calls) < 400 and abs(r.at - 0.37) < 0.01

@@ -148,3 +148,14 @@ def test_slanted_tops_mesh_towing_curve_agrees(body, jams):
     # another design than the paper's: no printed figure is shown beside it as if it were a target
     assert all(c.paper is None for c in result.comparisons)
     assert not any("paper" in label for plot in result.plots for label, x in plot.markers if x is not None)
+
+
+@pytest.mark.parametrize("tol", [10**400, -(10**400), 10**30])
+def test_a_whole_number_too_large_for_a_float_is_one_line(tol):
+    """Fuzz (the loader's hypothesis run): mesh_tol_mm = a 400-digit integer raised OverflowError
+    from math.isfinite; it is out of range, one line naming the field."""
+    from gearcheck.design import from_data
+    from gearcheck.params import ParamError
+
+    with pytest.raises(ParamError, match=r"mesh_tol_mm = .*out of range: allowed"):
+        from_data({"mechanism": "assembly", "name": "x", "mesh_tol_mm": tol})

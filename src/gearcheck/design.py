@@ -181,7 +181,7 @@ def _check_run_keys(data: dict, path: Path | None, source: str) -> None:
         return
     if isinstance(tol, bool) or not isinstance(tol, (int, float)):
         raise ParamError("mesh_tol_mm", tol, f"wrong type: input should be a number; {allowed}", source)
-    if not math.isfinite(tol):
+    if isinstance(tol, float) and not math.isfinite(tol):  # (an int of any size compares exactly below)
         raise ParamError("mesh_tol_mm", tol, f"must be a finite number ({allowed})", source)
     if not TOL_MIN_MM <= tol <= TOL_MAX_MM:
         raise ParamError("mesh_tol_mm", tol, f"out of range: {allowed}", source)

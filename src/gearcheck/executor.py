@@ -104,8 +104,13 @@ def _init_worker(setup_ref: tuple[str, str] | None, shared_file: str | None) -> 
     _quiet_worker()
     shared = None
     if shared_file is not None:
-        with open(shared_file, "rb") as fh:
-            shared = pickle.load(fh)
+        try:
+            with open(shared_file, "rb") as fh:
+                shared = pickle.load(fh)
+        except (OSError, EOFError, pickle.UnpicklingError):
+            # the parent wrote it before starting the pool and removes it only as the run ends
+            # (finished or interrupted): a worker starting that late has nothing to do
+            os._exit(0)
     setup = _resolve(setup_ref) if setup_ref is not None else None
     _worker_state = setup(shared) if setup is not None else shared
 

@@ -25,6 +25,8 @@ import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
+import numpy as np
+
 
 def interval_bound(c0: float, c1: float, delta: float) -> float:
     """The least clearance an interval can have: its ends' clearances c0, c1, no point moving more
@@ -127,3 +129,120 @@ def certify(xs: Sequence[float], cs: Sequence[float], measure: Callable[[float],
 def arc_displacement(radius_mm: float, angle_deg: float) -> float:
     """The path length of a point ``radius_mm`` from the axis turned by ``angle_deg``."""
     return radius_mm * math.radians(abs(angle_deg))
+
+
+@dataclass
+class Refined:
+    """The least value of a periodic figure over its cycle, refined between the samples:
+    ``least`` the least value evaluated (samples and points added), ``at`` where, ``lower`` the
+    bracket's lower end: the least any interval can hold by the rate bound, and no higher than
+    ``least`` less the precision asked for (the bracket [lower, least] is that wide unless the
+    rounds ran out), ``rate`` the largest rate bound used (per unit of x), ``refined`` the points
+    added."""
+
+    least: float
+    at: float
+    lower: float
+    rate: float
+    refined: int
+    rounds: int
+
+    @property
+    def bracket(self) -> float:
+        return self.least - self.lower
+
+
+RATE_FACTOR = 2.0  # the rate bound: this many times the steepest slope seen between neighbouring points
+
+
+def refine_least(xs: Sequence[float], ys: Sequence[float],
+                 evaluate: Callable[[list[float]], Sequence[float] | np.ndarray],
+                 period: float, precision: float, max_rounds: int = 40, max_points: int = 4096) -> Refined:
+    """Refine the least value of a figure y(x) periodic in x (one cycle sampled at ``xs``, the
+    values ``ys``; ``evaluate(points)`` gives it at new points, all of a round in one call) until
+    its bracket is below ``precision``: over each interval between neighbouring points (the last
+    to the first one period on), y ≥ (y0 + y1 − k·Δx)/2 with k the interval's rate bound
+    (:data:`RATE_FACTOR` times the steepest slope of it and its two neighbours, the new points
+    included: a flat stretch is not held to the rate of a handover elsewhere), and every interval
+    whose bound lies more than ``precision`` below the least value is split at its middle.
+    A rate read from the samples is not a proof (a dip narrower than the spacing and steeper than
+    every slope seen is missed): the refinement brackets the least value of a figure whose rate the
+    samples show, to its printed precision; where a proven rate exists, :func:`certify` is the
+    tool."""
+    return refine_least_many([(xs, ys)], lambda asked: evaluate([x for _, x in asked]), period, precision,
+                             max_rounds, max_points)[0]
+
+
+class _Cycle:
+    """One figure's points over its cycle, for :func:`refine_least_many`."""
+
+    def __init__(self, xs: Sequence[float] | np.ndarray, ys: Sequence[float] | np.ndarray, period: float):
+        x, y = np.asarray(xs, float), np.asarray(ys, float)
+        keep = np.isfinite(y)
+        self.x, self.y, self.period = x[keep], y[keep], period
+        self.refined = self.rounds = 0
+        self._sort()
+
+    def _sort(self) -> None:
+        order = np.argsort(self.x)
+        self.x, self.y = self.x[order], self.y[order]
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(each interval's lower bound, its ends' x (closed over the period), each interval's rate)."""
+        xx = np.append(self.x, self.x[0] + self.period)
+        yy = np.append(self.y, self.y[0])
+        dx = np.diff(xx)
+        slope = np.abs(np.diff(yy)) / np.where(dx > 0.0, dx, np.inf)
+        rates = RATE_FACTOR * np.maximum.reduce([np.roll(slope, 1), slope, np.roll(slope, -1)])
+        bound = np.minimum(np.minimum(yy[:-1], yy[1:]), 0.5 * (yy[:-1] + yy[1:] - rates * dx))
+        return bound, xx, rates
+
+    def needed(self, precision: float) -> list[float]:
+        bound, xx, _ = self.bounds()
+        need = np.flatnonzero(bound < float(self.y.min()) - precision)
+        return [float((xx[k] + xx[k + 1]) / 2.0) for k in need]
+
+    def add(self, xs: list[float], ys: np.ndarray) -> None:
+        new_x = np.mod(np.asarray(xs) - self.x[0], self.period) + self.x[0]
+        keep = np.isfinite(ys)
+        self.x, self.y = np.concatenate([self.x, new_x[keep]]), np.concatenate([self.y, ys[keep]])
+        self.refined += len(xs)
+        self.rounds += 1
+        self._sort()
+
+    def result(self, precision: float = 0.0) -> Refined:
+        """The bracket: its lower end no higher than the least value less ``precision`` (the rate is
+        read from the samples: the bracket is stated at the precision the refinement was asked for,
+        whatever the last bounds say)."""
+        if not len(self.x):
+            return Refined(math.nan, math.nan, math.nan, math.nan, self.refined, self.rounds)
+        bound, _, rates = self.bounds()
+        i = int(np.argmin(self.y))
+        lower = min(float(bound.min()), float(self.y[i]) - precision)
+        return Refined(float(self.y[i]), float(self.x[i]), lower, float(rates.max()), self.refined, self.rounds)
+
+
+def rate_bound(xs: Sequence[float] | np.ndarray, ys: Sequence[float] | np.ndarray, period: float) -> float:
+    """The least value a periodic figure sampled at ``xs`` can have by the rate bound of
+    :func:`refine_least`, before any point is added (NaN without a finite sample)."""
+    return _Cycle(xs, ys, period).result().lower
+
+
+def refine_least_many(curves: Sequence[tuple[Sequence[float], Sequence[float]]],
+                      evaluate: Callable[[list[tuple[int, float]]], Sequence[float] | np.ndarray],
+                      period: float, precision: float, max_rounds: int = 40,
+                      max_points: int = 4096) -> list[Refined]:
+    """:func:`refine_least` for several figures of one period at once: each round asks
+    ``evaluate`` for every figure's new points in one call, as (figure index, x) pairs."""
+    cycles = [_Cycle(xs, ys, period) for xs, ys in curves]
+    for _ in range(max_rounds):
+        asked = [(k, x) for k, c in enumerate(cycles) if len(c.x) and c.refined < max_points
+                 for x in c.needed(precision)]
+        if not asked:
+            break
+        values = np.asarray(evaluate(asked), float)
+        for k, c in enumerate(cycles):
+            mine = [i for i, (owner, _) in enumerate(asked) if owner == k]
+            if mine:
+                c.add([asked[i][1] for i in mine], values[mine])
+    return [c.result(precision) for c in cycles]

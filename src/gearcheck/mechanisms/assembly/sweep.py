@@ -39,7 +39,7 @@ from gearcheck.mechanisms.assembly.meshes import axis_radius as _radius
 from gearcheck.mechanisms.assembly.meshes import overlap_mover
 from gearcheck.mechanisms.assembly.meshes import box_corners as _corners
 from gearcheck.results import SweepOutcome, WorstPose
-from gearcheck.sweep.bodies import Body
+from gearcheck.sweep.bodies import Body, MeshData
 from gearcheck.sweep.certify import certify
 from gearcheck.sweep.motion import Rotation
 from gearcheck.geometry.bisect import bisect, bisect_predicted, remembered
@@ -68,9 +68,9 @@ class Spec:
     # the play part against each neighbour, per turning sense (+1, −1): (its mesh, the neighbour's),
     # each kept to the faces that motion can meet first (sweep.prune.approaching_faces)
     play_meshes: dict[tuple[str, float], tuple[str, str]]
-    # per pair: the corners of its two pruned meshes' boxes, each in its part's frame, for the bound
+    # per pair: the convex hull vertices of its two pruned meshes, each in its part's frame, for the bound
     # on how fast the clearance can change over an interval (:func:`interval_path`)
-    boxes: dict[str, tuple[np.ndarray, np.ndarray]]
+    hulls: dict[str, tuple[np.ndarray, np.ndarray]]
     grown: float  # the largest thermal scale: a state's meshes are no larger than this times the built
     resolution: dict[str, float]  # per pair: its mesh-error bound, the sharpest a bound can be
 
@@ -412,35 +412,53 @@ def _velocity(kin: Kinematics, part: str, w: np.ndarray) -> np.ndarray:
     return np.broadcast_to(line.gain * a, w.shape)
 
 
-def _placed_box(spec: Spec, part: str, corners: np.ndarray, x0: float, x1: float) -> np.ndarray:
-    """The corners of a world box holding the part's (pruned) mesh at every coordinate in [x0, x1]:
-    the box of its frame's box placed at both ends, grown by the longest path of a corner between
-    them (every point of a path lies within that of its start)."""
-    m0, m1 = spec.kin.pose(part, x0), spec.kin.pose(part, x1)
-    p0, p1 = corners @ m0[:3, :3].T + m0[:3, 3], corners @ m1[:3, :3].T + m1[:3, 3]
-    line = spec.kin.lines.get(part)
-    path = 0.0
-    if line is not None and line.coupled:
-        move = abs(line.gain * (x1 - x0))
-        path = move if line.unit == "mm" else max(_radius(line, c) for c in p0) * math.radians(move)
-    both = np.concatenate([p0, p1])
-    lo, hi = both.min(axis=0) - path, both.max(axis=0) + path
-    return np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+def _turn_rate(kin: Kinematics, part: str) -> np.ndarray:
+    """The angular velocity of ``part``'s motion per unit of the driver's coordinate (rad; zero for
+    a slide or a part that does not move)."""
+    line = kin.lines.get(part)
+    if line is None or not line.coupled or not isinstance(line.motion, Rotation):
+        return np.zeros(3)
+    return line.gain * math.pi / 180.0 * np.asarray(line.motion.axis, float)
 
 
 def interval_path(spec: Spec, rule: PairRule, x0: float, x1: float) -> float:
     """The longest path (mm) any point of one of the pair's meshes can take relative to the other
-    part over [x0, x1]: |x1 − x0| times the largest relative speed |v_a(w) − v_b(w)| of the two
-    motions' velocity fields (per unit of the driver) over a world box that holds the mesh all the
-    while; the speed is convex in w, so a corner of the box has the largest. The clearance changes
-    by no more (the distance does not change when both bodies are placed in one's frame, where only
-    the other moves); the smaller of the two meshes' figures is taken, grown by the thermal scale."""
+    part over [x0, x1] (the clearance changes by no more: the distance is the same with both
+    bodies placed in the other's frame, where only this one moves).
+
+    The relative velocity of the two motions, v(w) = v_a(w) − v_b(w) per unit of the driver, is an
+    affine field of the world point w with gradient Ω (the difference of the two turn rates); a
+    point p of the mesh starts at w0 with relative speed s0 = |v(w0)| and moves through the world at
+    the constant speed |v_a(w0)| of its own joint (an arc or a line), so over Δx its relative speed
+    stays ≤ s0 + |Ω|·|v_a(w0)|·t and its path relative to the other part ≤ s0·Δx + |Ω|·|v_a(w0)|·Δx²/2.
+    The relative speed is convex in w, so over the mesh the largest lies on the vertices of its
+    convex hull (kept per pair, :func:`hull_points`). The smaller of the two meshes' figures is
+    taken, grown by the thermal scale."""
+    dx = abs(x1 - x0)
+    kin = spec.kin
+    omega = float(np.linalg.norm(_turn_rate(kin, rule.a) - _turn_rate(kin, rule.b)))
     best = math.inf
-    for part, other, corners in ((rule.a, rule.b, spec.boxes[rule.key][0]), (rule.b, rule.a, spec.boxes[rule.key][1])):
-        box = _placed_box(spec, part, corners, x0, x1)
-        speed = float(np.linalg.norm(_velocity(spec.kin, part, box) - _velocity(spec.kin, other, box), axis=1).max())
-        best = min(best, speed)
-    return spec.grown * best * abs(x1 - x0)
+    for part, other, points in ((rule.a, rule.b, spec.hulls[rule.key][0]), (rule.b, rule.a, spec.hulls[rule.key][1])):
+        m0 = kin.pose(part, x0)
+        w = points @ m0[:3, :3].T + m0[:3, 3]
+        own = _velocity(kin, part, w)
+        s0 = np.linalg.norm(own - _velocity(kin, other, w), axis=1)
+        path = s0 * dx + omega * np.linalg.norm(own, axis=1) * dx * dx / 2.0
+        best = min(best, float(path.max()))
+    return spec.grown * best
+
+
+def hull_points(mesh: MeshData) -> np.ndarray:
+    """The vertices of the convex hull of a mesh's vertices (its part's frame): where a convex
+    function of the point (a relative speed) is largest over the mesh. The box's corners where the
+    hull cannot be built (a flat or tiny mesh)."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    v = np.asarray(mesh.vertices, float)
+    try:
+        return v[ConvexHull(v).vertices]
+    except (QhullError, ValueError):
+        return _corners(mesh)
 
 
 def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None) -> SweepPlan:
@@ -456,11 +474,11 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     play = {key: (a.name, b.name) for key, (a, b) in directed.items()}
     centres = {p: tuple(float(c) for c in _corners(b.mesh).mean(axis=0)) for p, b in bodies.items()}
     grown = 1.0 + max((abs(s - 1.0) for st in states for s in st.scales.values()), default=0.0)
-    boxes = {key: (_corners(ma), _corners(mb)) for key, (ma, mb) in pairs.items()}
+    hulls = {key: (hull_points(ma), hull_points(mb)) for key, (ma, mb) in pairs.items()}
     resolution = {r.key: bodies[r.a].error_bound_mm + bodies[r.b].error_bound_mm for r in lay.pairs}
     spec = Spec(kin, lay.pairs, lay.play, lay.play_limit, lay.play_neighbours,
                 {k: (a.name, b.name) for k, (a, b) in pairs.items()}, far, reach, margin,
-                centres, play, boxes, grown, resolution)  # type: ignore[arg-type]
+                centres, play, hulls, grown, resolution)  # type: ignore[arg-type]
     per_task = int(options.get("poses_per_task", POSES_PER_TASK))
     count = len(kin.coordinates)
     tasks, weights = [], []

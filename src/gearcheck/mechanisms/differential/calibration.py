@@ -100,12 +100,14 @@ class _Totals:
                                    ) from None
 
     def __call__(self, thinning_mm: float, which: str) -> float:
-        """The total over the whole cycle (both sides: twice the least play per side)."""
+        """The total over the whole cycle (both sides: twice the least play per side at the cycle's
+        drive angles)."""
         if thinning_mm not in self.known:
             plays = self._plays(thinning_mm, which)
             play = plays.play_arcmin[0]  # (angle, big gear)
             self.least_angle = float(plays.angles_rad[np.unravel_index(np.argmin(play), play.shape)[0]])
-            self.known[thinning_mm] = 2.0 * float(plays.least_arcmin[0])
+            # at the cycle's drive angles: a measured least backlash is read at the poses measured
+            self.known[thinning_mm] = 2.0 * float(plays.sampled_least_arcmin[0])
         return self.known[thinning_mm]
 
     def at_least_angle(self, thinning_mm: float, which: str) -> float:
@@ -113,7 +115,7 @@ class _Totals:
         never its result (a thinning moves every pose's play alike, so the least stays there; the
         result is always a whole cycle)."""
         assert self.least_angle is not None
-        return 2.0 * float(self._plays(thinning_mm, which, [self.least_angle]).least_arcmin[0])
+        return 2.0 * float(self._plays(thinning_mm, which, [self.least_angle]).sampled_least_arcmin[0])
 
 
 def _solve(params, totals: _Totals, target: float, which: str, start_mm: float,

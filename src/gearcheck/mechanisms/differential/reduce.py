@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -20,9 +20,10 @@ from gearcheck.mechanisms.differential.params import shim_key
 from gearcheck.mechanisms.differential.poses import GearSpecs
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup, normalised_poses, whole_name
 from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, merge_plays,
-                                                           range_check)
+                                                           range_check, refine_cycles)
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
 from gearcheck.results import SweepOutcome, WorstPose
+from gearcheck.sweep.certify import Refined
 
 # Mesh vs exact: within the mesh-error bound (as an angle on d1/2) plus this fraction.
 AGREEMENT_RELATIVE = 0.02
@@ -65,6 +66,9 @@ class SweepData:
     exact_solves: int
     exact_reused: int
     ranges: dict[int, RangeCheck]
+    # per (shim, state) measured: the exact least play over the continuous cycle, refined between
+    # the swept angles (:func:`_refined`)
+    refined: dict[tuple[int, int], Refined] = field(default_factory=dict)
 
     @property
     def w(self) -> int:
@@ -91,8 +95,19 @@ class SweepData:
         return self._cycle_min(self.geom_play)
 
     @property
-    def exact_min(self) -> np.ndarray:
+    def exact_sampled_min(self) -> np.ndarray:
+        """The exact least play at the swept drive angles only."""
         return self._cycle_min(self.exact_play)
+
+    @property
+    def exact_min(self) -> np.ndarray:
+        """The exact least play over the continuous cycle: the lower end of the refined bracket
+        (within the refinement's precision of the least value found), else the sampled one."""
+        out = self.exact_sampled_min.copy()
+        for (i, j), r in self.refined.items():
+            if math.isfinite(r.lower):
+                out[i, j] = min(out[i, j], r.lower)
+        return out
 
     @property
     def total_dev(self) -> np.ndarray:
@@ -193,7 +208,21 @@ def _arrays(setup: SweepSetup, by_key: dict, ranges: dict[int, RangeCheck]) -> S
         contact_dev=np.array([dv for dv, _ in deviation]),
         contact_ok=all(dv <= allowed for dv, allowed in deviation), total_ok=total_ok, contacts=len(by_key),
         bound_mm=setup.bound_mm, bound_arcmin=setup.bound_arcmin, exact_solves=setup.exact_solves,
-        exact_reused=setup.exact_reused, ranges=ranges)
+        exact_reused=setup.exact_reused, ranges=ranges, refined=_refined(setup, measured, exact_play))
+
+
+def _refined(setup: SweepSetup, measured: np.ndarray, exact_play: np.ndarray) -> dict[tuple[int, int], Refined]:
+    """Each measured state's exact least play over the continuous cycle: the swept drive angles'
+    plays (the tighter output shaft's at each), refined between them on the exact model
+    (:func:`.temperature.refine_cycles`: the same thermal states, new angles only), a shim's
+    states together."""
+    out: dict[tuple[int, int], Refined] = {}
+    for i, shim in enumerate(setup.shims):
+        states = [j for j in setup.shim_states[i] if measured[i, j]]
+        found = refine_cycles(setup.params, shim, [setup.states[j][1] for j in states], setup.angles,
+                              exact_play[i, states].min(axis=2), setup.period_rad, specs=setup.layout.specs)
+        out.update({(i, j): r for j, r in zip(states, found, strict=True)})
+    return out
 
 
 def _range_summary(data: SweepData, r: RangeCheck, i: int) -> dict:
@@ -231,6 +260,17 @@ def _range_summary(data: SweepData, r: RangeCheck, i: int) -> dict:
             "small_height_root_to_tip_minus": [s[1][1].height for s in spots],
         }
     return out
+
+
+def _refined_summary(data: SweepData, i: int, j: int) -> dict:
+    """The exact least play's refinement over the continuous cycle at shim i, state j."""
+    r = data.refined.get((i, j))
+    if r is None:
+        return {}
+    return {"exact_play_sampled_min_arcmin": float(data.exact_sampled_min[i, j]),
+            "exact_play_refined_least_arcmin": r.least, "exact_play_refined_at_deg": math.degrees(r.at),
+            "exact_play_rate_bound_arcmin_per_deg": r.rate * math.pi / 180.0,
+            "exact_play_points_added": r.refined, "exact_play_bracket_arcmin": r.bracket}
 
 
 def _summary(setup: SweepSetup, data: SweepData, by_key: dict) -> dict:
@@ -271,7 +311,8 @@ def _summary(setup: SweepSetup, data: SweepData, by_key: dict) -> dict:
     summary["states"] = {
         name: {"temperature_C": temp, "geom_play_min_arcmin": float(geom_min[t, j]),
                "exact_play_min_arcmin": float(exact_min[t, j]), "model_play_min_arcmin": data.model_play(t, temp),
-               "max_mesh_exact_play_deviation_arcmin": float(np.nanmax(data.total_dev[t, j]))}
+               "max_mesh_exact_play_deviation_arcmin": float(np.nanmax(data.total_dev[t, j])),
+               **_refined_summary(data, t, j)}
         for j, (name, temp) in enumerate(data.states)}
     if z is not None:
         summary["geom_shim_gain_per_side_arcmin"] = float(geom_min[t, w] - geom_min[z, w])

@@ -374,9 +374,11 @@ def measure_contact(scene: Scene, exact_rad: float, direction: int, meshes: list
 def exact_range_task(_scene: Scene, params, shim_mm: float, temperatures_C: list[float], angles_per_cycle: int
                      ) -> dict:
     """The exact model alone (no mesh) at some temperatures of the range: the plays over the cycle
-    and where the least-play contacts lie (plain arrays), and the onset of binding wherever the
-    least play crosses zero between two of them (solved here, beside the other tasks, rather than
-    after them all; a crossing between two tasks' temperatures is solved in the reduce step)."""
+    at its drive angles (the reduce step refines the leasts that can decide a range, over the whole
+    range: :func:`.temperature.refined`) and where the least-play contacts lie (plain arrays), and
+    the onset of binding wherever the least play crosses zero between two of them (solved here,
+    beside the other tasks, rather than after them all; a crossing between two tasks' temperatures
+    is solved in the reduce step)."""
     t0 = time.perf_counter()
     specs = gear_specs(params)
     plays = exact_plays_or_unsolved(params, shim_mm, temperatures_C, specs=specs, angles_per_cycle=angles_per_cycle)

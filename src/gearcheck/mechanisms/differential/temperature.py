@@ -23,6 +23,7 @@ proven by a sign change of the exact play either side of it), not interpolated.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -35,6 +36,7 @@ from gearcheck.geometry.bevel_contact import rigid_inverse
 from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period
 from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
+from gearcheck.sweep.certify import Refined, rate_bound, refine_least_many
 
 # Drive angles over one period of the output shafts' play (the mesh sweep uses the same).
 ANGLES_PER_CYCLE = 12
@@ -186,6 +188,9 @@ class ExactPlays:
     solves: int
     reused: int
     spots: list[list[list[FlankSpot]]] | None = field(default=None, compare=False)
+    # (T,): each temperature's least play over the continuous cycle, refined between the angles
+    # (:func:`refined`: the lower end of its bracket), where computed
+    lower_arcmin: np.ndarray | None = field(default=None, compare=False)
 
     @property
     def plus_arcmin(self) -> np.ndarray:
@@ -201,9 +206,16 @@ class ExactPlays:
         return self.plus_arcmin - self.minus_arcmin
 
     @property
-    def least_arcmin(self) -> np.ndarray:
-        """(T,): the least play per side over the cycle and both output shafts."""
+    def sampled_least_arcmin(self) -> np.ndarray:
+        """(T,): the least play per side at the cycle's drive angles, both output shafts."""
         return self.play_arcmin.min(axis=(1, 2))
+
+    @property
+    def least_arcmin(self) -> np.ndarray:
+        """(T,): the least play per side over the cycle and both output shafts: over the continuous
+        cycle where refined (:func:`refined`), else at its drive angles."""
+        least = self.sampled_least_arcmin
+        return least if self.lower_arcmin is None else np.fmin(least, self.lower_arcmin)
 
     @property
     def mean_arcmin(self) -> np.ndarray:
@@ -291,9 +303,11 @@ def exact_plays_or_unsolved(params, shim_mm: float, temperatures_C, *, specs: Ge
 
 def least_play(params, shim_mm: float, temperature_C: float, *, specs: GearSpecs | None = None,
                angles_per_cycle: int = ANGLES_PER_CYCLE) -> float:
-    """The exact least play per side (arcmin) at one temperature."""
+    """The exact least play per side (arcmin) at one temperature, at the cycle's drive angles (the
+    calibration's reading: a measured least backlash; :func:`refined` gives it over the continuous
+    cycle)."""
     return float(exact_plays(params, shim_mm, [temperature_C], specs=specs,
-                             angles_per_cycle=angles_per_cycle).least_arcmin[0])
+                             angles_per_cycle=angles_per_cycle).sampled_least_arcmin[0])
 
 
 def onset(params, shim_mm: float, free_C: float, binding_C: float, *, free_play: float | None = None,
@@ -304,8 +318,9 @@ def onset(params, shim_mm: float, free_C: float, binding_C: float, *, free_play:
     (the play is piecewise nearly linear in T), then the exact model at ONSET_TOL_K either side of
     it (one solve for both); a sign change there proves the root, else the bracket shrinks to the
     side that holds it and the step repeats."""
-    def plays(temps: list[float]) -> np.ndarray:
-        return exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle).least_arcmin
+    def plays(temps: list[float]) -> np.ndarray:  # over the continuous cycle, as the range's leasts
+        return refined(params, exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle),
+                       specs=specs).least_arcmin
 
     a, b = float(free_C), float(binding_C)
     fa = float(plays([a])[0]) if free_play is None else free_play
@@ -408,13 +423,16 @@ def range_check(params, shim_mm: float, *, grid: bool = True, specs: GearSpecs |
                 solved: Mapping[tuple[float, float], float] | None = None) -> RangeCheck:
     """The exact model over the operating and storage ranges at one shim: on the full grid
     (:func:`temperature_grid`), or at the named temperatures only (``grid=False``: concavity, see
-    the module docstring), or on given ``plays``; every zero crossing between neighbouring
+    the module docstring), or on given ``plays``; each temperature's least play over the continuous
+    cycle (:func:`refined`, unless the plays already are); every zero crossing between neighbouring
     temperatures solved on the exact model (those in ``solved`` already were: :func:`crossings`)."""
     specs = gear_specs(params) if specs is None else specs
     keys = key_temperatures(params)
     if plays is None:
         temps = temperature_grid(params) if grid else _unique(keys.values())
         plays = exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle)
+    if plays.lower_arcmin is None:  # each temperature's least over the continuous cycle
+        plays = refined(params, plays, specs=specs)
     onsets = crossings(params, shim_mm, plays, specs=specs, angles_per_cycle=angles_per_cycle, solved=solved)
     return RangeCheck(shim_mm, plays.temperatures_C, plays.least_arcmin, keys, tuple(sorted(onsets.values())),
                       specs.big.outer_pitch_diameter_mm / 2.0, grid, plays)
@@ -435,9 +453,10 @@ def crossings(params, shim_mm: float, plays: ExactPlays, *, specs: GearSpecs | N
             free, bind = (i, i + 1) if least[i] > 0.0 else (i + 1, i)
             key = (float(temps[free]), float(temps[bind]))
             known = None if solved is None else solved.get(key)
-            out[key] = known if known is not None else onset(
-                params, shim_mm, key[0], key[1], free_play=float(least[free]), binding_play=float(least[bind]),
-                specs=specs, angles_per_cycle=angles_per_cycle)
+            # the ends solved again by onset itself (over the continuous cycle): the same root
+            # whichever batch found the crossing
+            out[key] = known if known is not None else onset(params, shim_mm, key[0], key[1], specs=specs,
+                                                             angles_per_cycle=angles_per_cycle)
     return out
 
 
@@ -467,12 +486,101 @@ def merge_plays(parts: Sequence[ExactPlays]) -> ExactPlays:
     """Exact plays of one shim solved in chunks of temperatures, joined in temperature order."""
     parts = sorted(parts, key=lambda p: float(p.temperatures_C[0]))
     spots = None if any(p.spots is None for p in parts) else [s for p in parts for s in (p.spots or [])]
+    lower = (None if any(p.lower_arcmin is None for p in parts)
+             else np.concatenate([np.asarray(p.lower_arcmin) for p in parts]))
     return ExactPlays(parts[0].shim_mm, np.concatenate([p.temperatures_C for p in parts]), parts[0].angles_rad,
                       parts[0].period_rad, np.concatenate([p.plus_rad for p in parts]),
                       np.concatenate([p.minus_rad for p in parts]), sum(p.solves for p in parts),
-                      sum(p.reused for p in parts), spots)
+                      sum(p.reused for p in parts), spots, lower)
 
 
+# Each temperature's least play is refined between the cycle's drive angles until its bracket is
+# below this (arcmin: half the printed 0.001′), :func:`gearcheck.sweep.certify.refine_least_many`.
+REFINE_PRECISION_ARCMIN = 5e-4
+
+
+def plays_at(params, shim_mm: float, points: Sequence[tuple[float, float]], *,
+             specs: GearSpecs | None = None) -> np.ndarray:
+    """The exact play per side at each (temperature °C, drive angle rad) of ``points``, the tighter
+    output shaft's (arcmin), all solved in one vectorised batch (NaN for all where the model finds
+    no contact within its reach)."""
+    specs = gear_specs(params) if specs is None else specs
+    built = assembly_poses(specs, shim_mm).as_dict()
+    solve_big: list[bp.PlacedGear] = []
+    solve_small: list[bp.PlacedGear] = []
+    owners: list[list[tuple[int, int, int]]] = []
+    thermals: dict[float, dict] = {}
+    for n, (temp, phi) in enumerate(points):
+        if temp not in thermals:
+            thermals[temp] = thermal_state(params, cold_C=float(temp), specs=specs, shim_mm=shim_mm)
+        placed = placed_gears(specs, drive_poses(built, BIG_GEARS, SMALL_GEARS, specs.big, specs.small, float(phi)),
+                              thermals[temp])
+        groups, _ = congruent_groups(placed, specs.big, specs.small)
+        for big, small, members in groups:
+            solve_big.append(placed[big])
+            solve_small.append(placed[small])
+            owners.append([(n, BIG_GEARS.index(b), SMALL_GEARS.index(s)) for b, s in members])
+    shape = (len(points), len(BIG_GEARS), len(SMALL_GEARS))
+    if not owners:
+        return np.full(len(points), np.nan)
+    try:
+        contacts = dict(zip(DIRECTIONS, bp.big_gear_contacts_both(solve_big, solve_small), strict=True))
+    except RuntimeError:  # no contact within the model's reach somewhere
+        return np.full(len(points), np.nan)
+    plus, minus = np.empty(shape), np.empty(shape)
+    for j, keys in enumerate(owners):
+        for key in keys:
+            plus[key] = contacts[1][j].angle_rad
+            minus[key] = contacts[-1][j].angle_rad
+    return (bp.arcmin(plus.min(axis=2)) - bp.arcmin(minus.max(axis=2))).min(axis=1)
+
+
+def refine_cycles(params, shim_mm: float, temperatures_C: Sequence[float], angles_rad, per_angle_arcmin,
+                  period_rad: float, *, specs: GearSpecs | None = None) -> list[Refined]:
+    """The least play at each temperature (and one shim) over the continuous cycle, from its plays
+    at ``angles_rad`` (``per_angle_arcmin[i]``: the tighter output shaft's at each angle): refined
+    between them on the exact model until each bracket is below :data:`REFINE_PRECISION_ARCMIN`
+    (:func:`gearcheck.sweep.certify.refine_least_many`; each round's new points, every temperature's,
+    solved in one batch by :func:`plays_at`)."""
+    specs = gear_specs(params) if specs is None else specs
+    temps = [float(t) for t in temperatures_C]
+
+    def evaluate(asked: list[tuple[int, float]]) -> np.ndarray:
+        return plays_at(params, shim_mm, [(temps[k], x) for k, x in asked], specs=specs)
+
+    curves = [(angles_rad, per_angle_arcmin[i]) for i in range(len(temps))]
+    return refine_least_many(curves, evaluate, period_rad, REFINE_PRECISION_ARCMIN)
+
+
+def refined(params, plays: ExactPlays, *, specs: GearSpecs | None = None) -> ExactPlays:
+    """``plays`` with the least play over the continuous cycle (``lower_arcmin``, :func:`refine_cycles`)
+    at every temperature that can hold a range's least play: whose rate bound before refining
+    (:func:`gearcheck.sweep.certify.rate_bound`) lies below the least sampled play of its range
+    (operating, storage) plus the precision, or at or below zero while its samples are free (a sign
+    it could change). At the others the continuous least lies above their range's least, and the
+    samples stand (NaN there, as at a temperature without finite plays)."""
+    per_angle = plays.play_arcmin.min(axis=2)  # (T, angle): the tighter output shaft
+    temps = plays.temperatures_C
+    sampled = per_angle.min(axis=1)
+    solved = [i for i in range(len(temps)) if np.all(np.isfinite(per_angle[i]))]
+    bound = {i: rate_bound(plays.angles_rad, per_angle[i], plays.period_rad) for i in solved}
+    op = params.operating
+    chosen = {i for i in solved if bound[i] <= 0.0 < sampled[i]}
+    for lo, hi in ((op.operating_min_C, op.operating_max_C), (op.storage_min_C, op.storage_max_C)):
+        inside = [i for i in solved if lo - 1e-9 <= temps[i] <= hi + 1e-9]
+        if inside:
+            least = min(float(sampled[i]) for i in inside)
+            chosen |= {i for i in inside if bound[i] < least + REFINE_PRECISION_ARCMIN}
+    outside = [i for i in solved if not any(lo - 1e-9 <= temps[i] <= hi + 1e-9 for lo, hi in (
+        (op.operating_min_C, op.operating_max_C), (op.storage_min_C, op.storage_max_C)))]
+    chosen |= set(outside)  # a temperature of neither range (a lone state): its own least
+    order = sorted(chosen)
+    lower = np.full(len(temps), np.nan)
+    found = refine_cycles(params, plays.shim_mm, [temps[i] for i in order], plays.angles_rad, per_angle[order],
+                          plays.period_rad, specs=specs)
+    for i, r in zip(order, found, strict=True):
+        lower[i] = r.lower
+    return dataclasses.replace(plays, lower_arcmin=lower)
 def clearance(specs: GearSpecs, shim_mm: float, plays: Mapping[str, float], temperatures: Mapping[str, float]):
     """The smallest non-zero least play per side the mesh sweep decides a failing verdict on
     (:func:`smallest_play` over the states of :data:`MESH_DECIDED_STATES`) as the arc it spans on

@@ -190,7 +190,7 @@ class TrackCertificates:
         for name, f in (("plate_touch_", self.plate_touch), ("exact_plate_touch_", self.exact_plate_touch)):
             if f is not None:
                 out.update(f.as_dict(name))
-        return {**out, "seconds": self.seconds}
+        return out  # its time is a timing (sweep timings' certify_s), never in summary.json
 
     def interference_free(self, resolved: bool) -> tuple[bool, float, float]:
         """(no interference over the continuous motion, the least certified sleeve clearance and

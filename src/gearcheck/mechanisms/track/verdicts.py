@@ -96,9 +96,7 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                     **({} if cert is None else {"certified_min_tip_plate_mm": least_plate})},
                    evidence="mesh sweep (every link pose); exact 2-D model agrees"
                    + ("" if cert is None else "; " + CERTIFIED),
-                   shortfall=f"least tip–plate distance {least_plate:.4f} mm"
-                             + ("" if cert is None else " (certified over the continuous motion)")
-                             + f", required ≥ {lo:g} mm, short by {lo - least_plate:.4f} mm"),
+                   shortfall=_plate_short(min_plate.value, least_plate, lo, cert is not None)),
         Verdict.of("contact_proven", "clearances proven from both sides (free at −tol, contact at +tol)", proofs_hold,
                    f"tip gap: contact at {gap_proof.contact_mm:.5f} mm vs measured {gap_proof.measured_mm:.5f}; "
                    f"seat: contact at {sleeve_proof.contact_mm:.5f} mm vs measured {sleeve_proof.measured_mm:.5f}; "
@@ -118,6 +116,15 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                    shortfall=f"max |mesh − exact| {max(d.max_dev, worn_dev):.4f} mm, allowed ≤ {bound:.4f} mm, over by "
                              f"{max(d.max_dev, worn_dev) - bound:.4f} mm"),
     ]
+
+
+def _plate_short(sampled: float, certified: float, lo: float, has_certificate: bool) -> str:
+    """Why the least tip-to-plate distance falls short: a swept pose's own figure where one fails
+    (a measurement), else the bound over the continuous motion (the shortfall lies between poses)."""
+    if rounded(sampled) < lo or not has_certificate:
+        return f"least tip–plate distance {sampled:.4f} mm, required ≥ {lo:g} mm, short by {lo - sampled:.4f} mm"
+    return (f"least tip–plate distance {certified:.4f} mm between the swept angles (certified over the continuous "
+            f"motion; at the angles ≥ {sampled:.4f} mm), required ≥ {lo:g} mm, short by {lo - certified:.4f} mm")
 
 
 def _proof_shortfall(name: str, proof, bound: float, tol: float) -> str:
