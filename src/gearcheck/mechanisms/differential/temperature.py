@@ -304,8 +304,7 @@ def exact_plays_or_unsolved(params, shim_mm: float, temperatures_C, *, specs: Ge
 def least_play(params, shim_mm: float, temperature_C: float, *, specs: GearSpecs | None = None,
                angles_per_cycle: int = ANGLES_PER_CYCLE) -> float:
     """The exact least play per side (arcmin) at one temperature, at the cycle's drive angles (the
-    calibration's reading: a measured least backlash; :func:`refined` gives it over the continuous
-    cycle)."""
+    calibration's reading of a measured least backlash; over the continuous cycle: :func:`refined`)."""
     return float(exact_plays(params, shim_mm, [temperature_C], specs=specs,
                              angles_per_cycle=angles_per_cycle).sampled_least_arcmin[0])
 
@@ -314,17 +313,39 @@ def onset(params, shim_mm: float, free_C: float, binding_C: float, *, free_play:
           binding_play: float | None = None, specs: GearSpecs | None = None,
           angles_per_cycle: int = ANGLES_PER_CYCLE) -> float:
     """The temperature (°C) between a free one and a binding one where the exact least play per
-    side reaches zero (contact starts), on the exact model to ±ONSET_TOL_K: a regula falsi step
-    (the play is piecewise nearly linear in T), then the exact model at ONSET_TOL_K either side of
-    it (one solve for both); a sign change there proves the root, else the bracket shrinks to the
-    side that holds it and the step repeats."""
-    def plays(temps: list[float]) -> np.ndarray:  # over the continuous cycle, as the range's leasts
+    side over the continuous cycle reaches zero (contact starts), to ±ONSET_TOL_K (:func:`_falsi`):
+    solved on the plays at the cycle's drive angles (``free_play`` / ``binding_play``: at the ends,
+    if known), then proven on the plays over the continuous cycle (:func:`refined`: a few hundredths
+    of a kelvin away at most), solved on from there where the proof fails."""
+    def sampled(temps: list[float]) -> np.ndarray:
+        return exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle).sampled_least_arcmin
+
+    def continuous(temps: list[float]) -> np.ndarray:
         return refined(params, exact_plays(params, shim_mm, temps, specs=specs, angles_per_cycle=angles_per_cycle),
                        specs=specs).least_arcmin
 
     a, b = float(free_C), float(binding_C)
-    fa = float(plays([a])[0]) if free_play is None else free_play
-    fb = float(plays([b])[0]) if binding_play is None else binding_play
+    way = 1.0 if b > a else -1.0  # from the free end toward the binding end
+    try:
+        t = _falsi(sampled, a, b, free_play, binding_play)
+    except ValueError:  # the samples see no crossing: the continuous plays decide alone
+        return _falsi(continuous, a, b, None, None)
+    near, far = t - way * ONSET_TOL_K, t + way * ONSET_TOL_K
+    f_near, f_far = (float(v) for v in continuous([near, far]))
+    if f_near > 0.0 >= f_far:
+        return t
+    # the continuous root lies beyond the proof: solve on from the side that holds it
+    return _falsi(continuous, a, near, None, f_near) if f_near <= 0.0 else _falsi(continuous, far, b, f_far, None)
+
+
+def _falsi(plays, a: float, b: float, fa: float | None, fb: float | None) -> float:
+    """Regula falsi on ``plays`` (temperatures → least plays) from a free ``a`` to a binding ``b``
+    (their plays if known): a step (the play is piecewise nearly linear in T), then the plays at
+    ONSET_TOL_K either side of it (one solve for both); a sign change there proves the root, else
+    the bracket shrinks to the side that holds it and the step repeats."""
+    free_C, binding_C = a, b
+    fa = float(plays([a])[0]) if fa is None else fa
+    fb = float(plays([b])[0]) if fb is None else fb
     if not (fa > 0.0 >= fb):
         raise ValueError(f"no onset between {free_C} °C ({fa:.4f}′) and {binding_C} °C ({fb:.4f}′)")
     way = 1.0 if b > a else -1.0  # from the free end toward the binding end
@@ -554,11 +575,9 @@ def refine_cycles(params, shim_mm: float, temperatures_C: Sequence[float], angle
 
 def refined(params, plays: ExactPlays, *, specs: GearSpecs | None = None) -> ExactPlays:
     """``plays`` with the least play over the continuous cycle (``lower_arcmin``, :func:`refine_cycles`)
-    at every temperature that can hold a range's least play: whose rate bound before refining
-    (:func:`gearcheck.sweep.certify.rate_bound`) lies below the least sampled play of its range
-    (operating, storage) plus the precision, or at or below zero while its samples are free (a sign
-    it could change). At the others the continuous least lies above their range's least, and the
-    samples stand (NaN there, as at a temperature without finite plays)."""
+    wherever it can hold a range's least: the rate bound before refining (:func:`gearcheck.sweep.certify.rate_bound`)
+    below its range's least sample plus the precision, or ≤ 0 with free samples (NaN elsewhere: the
+    samples stand, their continuous least above the range's)."""
     per_angle = plays.play_arcmin.min(axis=2)  # (T, angle): the tighter output shaft
     temps = plays.temperatures_C
     sampled = per_angle.min(axis=1)
@@ -566,14 +585,13 @@ def refined(params, plays: ExactPlays, *, specs: GearSpecs | None = None) -> Exa
     bound = {i: rate_bound(plays.angles_rad, per_angle[i], plays.period_rad) for i in solved}
     op = params.operating
     chosen = {i for i in solved if bound[i] <= 0.0 < sampled[i]}
-    for lo, hi in ((op.operating_min_C, op.operating_max_C), (op.storage_min_C, op.storage_max_C)):
+    ranges = ((op.operating_min_C, op.operating_max_C), (op.storage_min_C, op.storage_max_C))
+    for lo, hi in ranges:
         inside = [i for i in solved if lo - 1e-9 <= temps[i] <= hi + 1e-9]
         if inside:
             least = min(float(sampled[i]) for i in inside)
             chosen |= {i for i in inside if bound[i] < least + REFINE_PRECISION_ARCMIN}
-    outside = [i for i in solved if not any(lo - 1e-9 <= temps[i] <= hi + 1e-9 for lo, hi in (
-        (op.operating_min_C, op.operating_max_C), (op.storage_min_C, op.storage_max_C)))]
-    chosen |= set(outside)  # a temperature of neither range (a lone state): its own least
+    chosen |= {i for i in solved if not any(lo - 1e-9 <= temps[i] <= hi + 1e-9 for lo, hi in ranges)}
     order = sorted(chosen)
     lower = np.full(len(temps), np.nan)
     found = refine_cycles(params, plays.shim_mm, [temps[i] for i in order], plays.angles_rad, per_angle[order],
