@@ -188,8 +188,7 @@ class ExactPlays:
     solves: int
     reused: int
     spots: list[list[list[FlankSpot]]] | None = field(default=None, compare=False)
-    # (T,): each temperature's least play over the continuous cycle, refined between the angles
-    # (:func:`refined`: the lower end of its bracket), where computed
+    # (T,): the least play over the continuous cycle where refined (:func:`refined`: its bracket's lower end)
     lower_arcmin: np.ndarray | None = field(default=None, compare=False)
 
     @property
@@ -223,6 +222,50 @@ class ExactPlays:
         return self.play_arcmin.mean(axis=(1, 2))
 
 
+@dataclass(frozen=True)
+class _Solved:
+    """Per pose, big and small gear: each way's contact turn (rad) and the solve that gave it."""
+
+    plus: np.ndarray
+    minus: np.ndarray
+    solved_by: np.ndarray
+    bigs: list[bp.PlacedGear]
+    smalls: list[bp.PlacedGear]
+    contacts: dict[int, list]
+    reused: int
+
+
+def _solve(params, shim_mm: float, points: Sequence[tuple[float, float]], specs: GearSpecs) -> _Solved:
+    """Every (°C, drive angle rad) of ``points`` solved in one vectorised batch, each distinct mesh
+    once (congruent twins share it); RuntimeError where no contact lies within the model's reach."""
+    built = assembly_poses(specs, shim_mm).as_dict()
+    bigs: list[bp.PlacedGear] = []
+    smalls: list[bp.PlacedGear] = []
+    owners: list[list[tuple[int, int, int]]] = []
+    thermals: dict[float, dict] = {}
+    reused = 0
+    for n, (temp, phi) in enumerate(points):
+        if temp not in thermals:
+            thermals[temp] = thermal_state(params, cold_C=float(temp), specs=specs, shim_mm=shim_mm)
+        placed = placed_gears(specs, drive_poses(built, BIG_GEARS, SMALL_GEARS, specs.big, specs.small, float(phi)),
+                              thermals[temp])
+        groups, twins = congruent_groups(placed, specs.big, specs.small)
+        reused += twins
+        for big, small, members in groups:
+            bigs.append(placed[big])
+            smalls.append(placed[small])
+            owners.append([(n, BIG_GEARS.index(b), SMALL_GEARS.index(s)) for b, s in members])
+    contacts = dict(zip(DIRECTIONS, bp.big_gear_contacts_both(bigs, smalls), strict=True))
+    shape = (len(points), len(BIG_GEARS), len(SMALL_GEARS))
+    plus, minus, solved_by = np.empty(shape), np.empty(shape), np.empty(shape, dtype=int)
+    for j, keys in enumerate(owners):
+        for key in keys:
+            plus[key] = contacts[1][j].angle_rad
+            minus[key] = contacts[-1][j].angle_rad
+            solved_by[key] = j
+    return _Solved(plus, minus, solved_by, bigs, smalls, contacts, reused)
+
+
 def exact_plays(params, shim_mm: float, temperatures_C, *, specs: GearSpecs | None = None,
                 angles_per_cycle: int = ANGLES_PER_CYCLE, spots: bool = False,
                 angles_rad: Sequence[float] | None = None) -> ExactPlays:
@@ -231,34 +274,14 @@ def exact_plays(params, shim_mm: float, temperatures_C, *, specs: GearSpecs | No
     least-play pose's contacts lie."""
     specs = gear_specs(params) if specs is None else specs
     temps = np.atleast_1d(np.asarray(temperatures_C, dtype=float))
-    built = assembly_poses(specs, shim_mm).as_dict()
     angles, period = cycle_angles(specs, shim_mm, angles_per_cycle)
     if angles_rad is not None:
         angles = np.asarray(angles_rad, float)
-    solve_big: list[bp.PlacedGear] = []
-    solve_small: list[bp.PlacedGear] = []
-    owners: list[list[tuple[int, int, int, int]]] = []
-    reused = 0
-    for i, temp in enumerate(temps):
-        thermal = thermal_state(params, cold_C=float(temp), specs=specs, shim_mm=shim_mm)
-        for k, phi in enumerate(angles):
-            placed = placed_gears(specs, drive_poses(built, BIG_GEARS, SMALL_GEARS, specs.big, specs.small,
-                                                     float(phi)), thermal)
-            groups, twins = congruent_groups(placed, specs.big, specs.small)
-            reused += twins
-            for big, small, members in groups:
-                solve_big.append(placed[big])
-                solve_small.append(placed[small])
-                owners.append([(i, k, BIG_GEARS.index(b), SMALL_GEARS.index(s)) for b, s in members])
-    contacts = dict(zip(DIRECTIONS, bp.big_gear_contacts_both(solve_big, solve_small), strict=True))
+    solved = _solve(params, shim_mm, [(float(t), float(phi)) for t in temps for phi in angles], specs)
     shape = (len(temps), len(angles), len(BIG_GEARS), len(SMALL_GEARS))
-    plus, minus, solved_by = np.empty(shape), np.empty(shape), np.empty(shape, dtype=int)
-    for j, keys in enumerate(owners):
-        for key in keys:
-            plus[key] = contacts[1][j].angle_rad
-            minus[key] = contacts[-1][j].angle_rad
-            solved_by[key] = j
-    out = ExactPlays(shim_mm, temps, angles, period, plus, minus, len(owners), reused)
+    plus, minus, solved_by = (a.reshape(shape) for a in (solved.plus, solved.minus, solved.solved_by))
+    contacts, solve_big, solve_small, reused = solved.contacts, solved.bigs, solved.smalls, solved.reused
+    out = ExactPlays(shim_mm, temps, angles, period, plus, minus, len(solve_big), reused)
     if not spots:
         return out
     where = []
@@ -271,7 +294,7 @@ def exact_plays(params, shim_mm: float, temperatures_C, *, specs: GearSpecs | No
             c = contacts[d][j]
             per_way.append([flank_spot(solve_big[j], c.angle_rad, c.point), flank_spot(solve_small[j], 0.0, c.point)])
         where.append(per_way)
-    return ExactPlays(shim_mm, temps, angles, period, plus, minus, len(owners), reused, where)
+    return ExactPlays(shim_mm, temps, angles, period, plus, minus, len(solve_big), reused, where)
 
 
 def unsolved(shim_mm: float, temperature_C: float, angles_rad: np.ndarray, period_rad: float) -> ExactPlays:
@@ -515,8 +538,7 @@ def merge_plays(parts: Sequence[ExactPlays]) -> ExactPlays:
                       sum(p.reused for p in parts), spots, lower)
 
 
-# Each temperature's least play is refined between the cycle's drive angles until its bracket is
-# below this (arcmin: half the printed 0.001′), :func:`gearcheck.sweep.certify.refine_least_many`.
+# A least play is refined between the drive angles to a bracket below this (arcmin; printed: 0.001′).
 REFINE_PRECISION_ARCMIN = 5e-4
 
 
@@ -525,35 +547,13 @@ def plays_at(params, shim_mm: float, points: Sequence[tuple[float, float]], *,
     """The exact play per side at each (temperature °C, drive angle rad) of ``points``, the tighter
     output shaft's (arcmin), all solved in one vectorised batch (NaN for all where the model finds
     no contact within its reach)."""
-    specs = gear_specs(params) if specs is None else specs
-    built = assembly_poses(specs, shim_mm).as_dict()
-    solve_big: list[bp.PlacedGear] = []
-    solve_small: list[bp.PlacedGear] = []
-    owners: list[list[tuple[int, int, int]]] = []
-    thermals: dict[float, dict] = {}
-    for n, (temp, phi) in enumerate(points):
-        if temp not in thermals:
-            thermals[temp] = thermal_state(params, cold_C=float(temp), specs=specs, shim_mm=shim_mm)
-        placed = placed_gears(specs, drive_poses(built, BIG_GEARS, SMALL_GEARS, specs.big, specs.small, float(phi)),
-                              thermals[temp])
-        groups, _ = congruent_groups(placed, specs.big, specs.small)
-        for big, small, members in groups:
-            solve_big.append(placed[big])
-            solve_small.append(placed[small])
-            owners.append([(n, BIG_GEARS.index(b), SMALL_GEARS.index(s)) for b, s in members])
-    shape = (len(points), len(BIG_GEARS), len(SMALL_GEARS))
-    if not owners:
-        return np.full(len(points), np.nan)
+    if not points:
+        return np.full(0, np.nan)
     try:
-        contacts = dict(zip(DIRECTIONS, bp.big_gear_contacts_both(solve_big, solve_small), strict=True))
+        solved = _solve(params, shim_mm, points, gear_specs(params) if specs is None else specs)
     except RuntimeError:  # no contact within the model's reach somewhere
         return np.full(len(points), np.nan)
-    plus, minus = np.empty(shape), np.empty(shape)
-    for j, keys in enumerate(owners):
-        for key in keys:
-            plus[key] = contacts[1][j].angle_rad
-            minus[key] = contacts[-1][j].angle_rad
-    return (bp.arcmin(plus.min(axis=2)) - bp.arcmin(minus.max(axis=2))).min(axis=1)
+    return (bp.arcmin(solved.plus.min(axis=2)) - bp.arcmin(solved.minus.max(axis=2))).min(axis=1)
 
 
 def refine_cycles(params, shim_mm: float, temperatures_C: Sequence[float], angles_rad, per_angle_arcmin,
