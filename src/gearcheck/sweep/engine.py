@@ -71,6 +71,11 @@ class Scene:
         use. A name already in the scene must stay its mesh: adding it again changes nothing."""
         self._meshes.setdefault(mesh.name, mesh)
 
+    def discard(self, name: str) -> None:
+        """Drop a body added by a task (its mesh and BVH): a cut that is no longer used."""
+        self._meshes.pop(name, None)
+        self._objects.pop(name, None)
+
     @property
     def built(self) -> list[str]:
         """The bodies whose BVH exists so far."""

@@ -24,7 +24,7 @@ from __future__ import annotations
 import functools
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -33,6 +33,8 @@ import numpy as np
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.assembly.assembly import Layout, PairRule
 from gearcheck.mechanisms.assembly.kinematics import Kinematics
+from gearcheck.mechanisms.assembly.local import Cuts
+from gearcheck.mechanisms.assembly.play import contact_move
 from gearcheck.mechanisms.assembly.meshes import (AS_BUILT, StateSpec, pair_meshes, play_meshes, state_meshes,
                                                   state_specs)
 from gearcheck.mechanisms.assembly.meshes import axis_radius as _radius
@@ -42,7 +44,6 @@ from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData
 from gearcheck.sweep.certify import certify
 from gearcheck.sweep.motion import Rotation
-from gearcheck.geometry.bisect import bisect, bisect_predicted, remembered
 from gearcheck.sweep.tools import CountedScene, clearing_distance
 
 BISECT_DEG = 2e-4  # play and overlap bisections stop at this bracket (deg: 0.72″, 1.7e-4 mm at r = 50) ...
@@ -155,113 +156,17 @@ def _pushed_apart(scene: CountedScene, name: str, other: str, pose: np.ndarray, 
     return best
 
 
-NEWTON_STEPS = 4  # distance queries at most per contact estimate
-EXTRAPOLATION_MEMORY = 4  # the last poses a line is fitted to, for the next pose's estimate
-EXTRAPOLATION_MARGIN_TOL = 1.5  # the least margin, in bisection tolerances
-FIRST_MARGIN_TOL = 8.0  # the margin around the last pose's move alone, in bisection tolerances
-WIDER = 8.0  # a second try around the same extrapolation: its margin this many times wider
-NEWTON_DAMPING = (0.6, 0.9, 0.95)  # each step goes this share of the predicted way (a first one runs long)
-
-
-def _gap_rate(scene: CountedScene, spec: Spec, part: str, sign: float, ahead: list[str],
-              facing: list[str]) -> tuple[float, float] | None:
-    """(gap, closing rate per unit move) to the nearest neighbour at the current pose: the distance
-    between the nearest points and n·v (n the unit normal from the mover's nearest point to the
-    neighbour's, v the mover's velocity there per unit move of its joint). None where touching or
-    the gap does not close."""
-    line = spec.kin.lines[part]
-    best = None
-    for m, o in zip(ahead, facing, strict=True):
-        d = scene.distance(m, o)
-        if not d.distance > 0.0:
-            return (0.0, 1.0)  # touching
-        n = (d.point_b - d.point_a) / d.distance
-        if line.unit == "deg":
-            motion = line.motion
-            assert isinstance(motion, Rotation)
-            a, origin = np.asarray(motion.axis, float), np.asarray(motion.origin, float)
-            rate = sign * float(n @ np.cross(a, d.point_a - origin)) * math.pi / 180.0
-        else:
-            rate = sign * float(n @ np.asarray(line.motion.axis, float))
-        if rate > 1e-12 and (best is None or d.distance / rate < best[0] / best[1]):
-            best = (d.distance, rate)
-    return best
-
-
-def _newton(scene: CountedScene, spec: Spec, part: str, x: float, sign: float, ahead: list[str],
-            facing: list[str], tol: float, limit: float) -> tuple[float, float] | None:
-    """(estimate, margin) of the move that brings the play part into contact, from damped Newton
-    steps on the gap between nearest points (:func:`_gap_rate`, one distance query each; every
-    step stays free, a positive distance says so): an estimate only, the contact is still proven
-    by collisions. None where it cannot say."""
-    free, at, step = 0.0, 0.0, math.inf
-    for k in range(NEWTON_STEPS):
-        pose = spec.kin.pose(part, x, sign * at)
-        for name in ahead:
-            scene.set_pose(name, pose)
-        gr = _gap_rate(scene, spec, part, sign, ahead, facing)
-        if gr is None:
-            return None
-        if gr[0] == 0.0:  # the step ran into contact: it lies between the last free move and this one
-            return 0.5 * (free + at), 0.5 * (at - free) + tol
-        free, step = at, gr[0] / gr[1]
-        if step <= tol or at + step >= limit:
-            break
-        at += NEWTON_DAMPING[min(k, len(NEWTON_DAMPING) - 1)] * step
-    return free + step, max(tol, step)
-
-
-def _extrapolated(history: list[float], tol: float, widen: float = 1.0) -> tuple[float, float] | None:
-    """(estimate, margin) of the next pose's move from the last poses' (the motion's poses are
-    close: the contact moves little from one to the next), or None without one. With
-    :data:`EXTRAPOLATION_MEMORY` of them, a straight line fitted to them (the moves are bisection
-    brackets, each rounded by up to one tolerance: the fit averages that out), its margin from how
-    far the fitted points lie off the line; with fewer, the line through the last two, its margin
-    their difference; with one, that move, its margin :data:`FIRST_MARGIN_TOL` tolerances. Each
-    margin times ``widen`` (a second try after the first estimate failed to prove its bracket)."""
-    recent = history[-EXTRAPOLATION_MEMORY:]
-    if not history or not (math.isfinite(history[-1]) and history[-1] > 0.0):
-        return None
-    if len(history) < 2 or not (math.isfinite(history[-2]) and history[-2] > 0.0):
-        return history[-1], widen * FIRST_MARGIN_TOL * tol
-    if len(recent) < EXTRAPOLATION_MEMORY or not all(math.isfinite(h) and h > 0.0 for h in recent):
-        last, before = history[-1], history[-2]
-        return last + (last - before), widen * max(2.0 * tol, abs(last - before))
-    k = np.arange(len(recent), dtype=float)
-    slope, offset = np.polyfit(k, np.asarray(recent, float), 1)
-    off = float(np.abs(offset + slope * k - np.asarray(recent, float)).max())
-    return float(offset + slope * len(recent)), widen * max(EXTRAPOLATION_MARGIN_TOL * tol, 2.0 * off + tol)
-
-
-def _to_contact(hits_at: Callable[[float], bool], tol: float, limit: float,
-                estimates: tuple[Callable[[], tuple[float, float] | None], ...],
-                known: dict[float, bool] | None = None) -> float:
-    """The touching end of the bracket the plain bisection of [0, limit] ends with (``limit`` where
-    nothing touches within it), found around the first estimate that proves its bracket (each an
-    (estimate, margin) or None, tried in order, answers shared), else by that bisection. ``known``:
-    answers already had (the pose itself, say: free)."""
-    ask, asked = remembered(hits_at)
-    asked.update(known or {})
-    for make in estimates:
-        estimate = make()
-        if estimate is None or not 0.0 < estimate[0] < limit:
-            continue
-        found = bisect_predicted(ask, 0.0, limit, tol, estimate[0], estimate[1], asked=asked)
-        if found is not None:
-            return found[0].touching
-    return bisect(ask, 0.0, limit, tol, check_ends=False).touching if ask(limit) else limit
-
-
 def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bool,
-          history: tuple[list[float], list[float]] = ([], []), free: bool = False) -> tuple[float, float, float, float]:
+          history: tuple[list[float], list[float]] = ([], []), free: bool = False,
+          cuts: Cuts | None = None) -> tuple[float, float, float, float]:
     """(plus, minus) moves of the play part from its coupled position to contact with any of its
     neighbours, the others held (a part already in contact, ``overlapping`` at the pose: the
     negative clearing move), and the index of the neighbour touched at each (NaN: none within the
     limit); ``free``: every pair of the part was found apart at this pose (not asked again). Each
     move is the bracket the plain bisection of [0, limit] ends with, found with few collisions
-    around an estimate (the last poses' moves extrapolated, then with a wider margin, then Newton
-    steps on the gap, :func:`_newton`; the bracket proven from both sides), else by the plain
-    bisection."""
+    around an estimate (:func:`~gearcheck.mechanisms.assembly.play.contact_move`), else by the
+    plain bisection. ``cuts``: the task's cuts around the contacts
+    (:mod:`~gearcheck.mechanisms.assembly.local`), kept between poses."""
     part = spec.play
     assert part is not None
     line = spec.kin.lines[part]
@@ -272,6 +177,7 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
     suffix = "" if state == AS_BUILT else f"@{state}"
     tol, limit = _unit_tol(line.unit), spec.play_limit
     moves, touched = [], []
+    cuts = Cuts(scene.scene) if cuts is None else cuts
     for sign, past in zip((1.0, -1.0), history, strict=True):
         names = [spec.play_meshes[(n, sign)] for n in near]
         ahead, facing = [m + suffix for m, _ in names], [o + suffix for _, o in names]
@@ -281,13 +187,6 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
         for name in facing:  # the neighbours' directed meshes at this pose
             scene.set_pose(name, spec.kin.pose(name.partition("~")[0], x))
 
-        def hits_at(d: float, sign: float = sign, ahead: list[str] = ahead, facing: list[str] = facing) -> bool:
-            if d == 0.0:  # at the pose itself: the whole pruned meshes (an overlap may be on any face)
-                return any(scene.collide(m, o) for m, o in zip(mine, others, strict=True))
-            pose = spec.kin.pose(part, x, sign * d)
-            for name in ahead:
-                scene.set_pose(name, pose)
-            return any(scene.collide(m, o) for m, o in zip(ahead, facing, strict=True))
         if overlapping:  # how far back the other way frees it, on the whole pruned meshes (any face)
             def back(d: float, s: float = -sign) -> bool:
                 pose = spec.kin.pose(part, x, s * d)
@@ -298,13 +197,8 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
             for name in mine:
                 scene.set_pose(name, nominal)
         else:
-            # the last poses' moves extrapolated (collisions only), else Newton steps on the gap
-            move = _to_contact(hits_at, tol, limit, (
-                functools.partial(_extrapolated, past, tol),
-                functools.partial(_extrapolated, past, tol, WIDER),
-                functools.partial(_newton, scene, spec, part, x, sign, ahead, facing, tol, limit)),
-                known={0.0: False} if free else None)
-            at = move
+            move = at = contact_move(scene, spec, cuts, x, sign, [(sign, n, state) for n in near], ahead, facing,
+                                     (mine, others), past, free, tol)
         who = None
         if move < limit and len(near) == 1:
             who = 0
@@ -338,6 +232,28 @@ def _certified(scene: CountedScene, spec: Spec, rule: PairRule, state: str, xs: 
             "refined": cert.refined, "undecided": len(cert.undecided)}
 
 
+def _certificates(scene: CountedScene, spec: Spec, state: str, indices: list[int], clearance: np.ndarray,
+                  after: int | None) -> dict[str, dict]:
+    """Each moving pair's clearance certified over a task's poses (``clearance``: one row per pose),
+    on to the pose ``after`` (the next task's first: measured here, not recorded)."""
+    kin = spec.kin
+    certificates: dict[str, dict] = {}
+    for k, rule in enumerate(spec.pairs):
+        if rule.key in spec.far or not rule.moving or rule.kind == "contact":
+            continue
+        xs = [float(kin.coordinates[i]) for i in indices]
+        cs = [float(c) for c in clearance[:, k]]
+        if after is not None:
+            x = float(kin.coordinates[after])
+            a, b = spec.mesh(rule, rule.a, state), spec.mesh(rule, rule.b, state)
+            scene.set_pose(a, kin.pose(rule.a, x))
+            scene.set_pose(b, kin.pose(rule.b, x))
+            xs.append(x)
+            cs.append(-BISECT_MM if scene.collide(a, b) else scene.distance(a, b).distance)
+        certificates[rule.key] = _certified(scene, spec, rule, state, xs, cs)
+    return certificates
+
+
 def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, after: int | None = None) -> dict:
     """One task: the poses ``indices`` of one state (``first``: the motion's first pose is among
     them, where pairs that do not move relative to each other are checked), and each moving pair's
@@ -360,6 +276,7 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     play = np.full((n, 4), np.nan)  # plus, minus, neighbour touched plus, minus
     start = time.perf_counter()
     play_s: list[float] = []  # one play measurement (both ways) per pose
+    cuts = Cuts(scene.scene)
     for row, i in enumerate(indices):
         x = float(kin.coordinates[i])
         scene.set_poses({spec.mesh(r, p, state): kin.pose(p, x) for r in live for p in (r.a, r.b)})
@@ -379,22 +296,10 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
             mine = [k for k, r in enumerate(spec.pairs) if spec.play in (r.a, r.b) and r.key not in spec.far]
             hit = any(np.isfinite(overlap_mm[row, k]) or np.isinf(overlap_mm[row, k]) for k in mine)
             free = all(clearance[row, k] > 0.0 for k in mine)  # each asked at this pose, and apart
-            play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])), free)
+            play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])), free, cuts)
             play_s.append(time.perf_counter() - t0)
-    certificates: dict[str, dict] = {}
-    for k, rule in enumerate(spec.pairs):
-        if rule.key in spec.far or not rule.moving or rule.kind == "contact":
-            continue
-        xs = [float(kin.coordinates[i]) for i in indices]
-        cs = [float(c) for c in clearance[:, k]]
-        if after is not None:
-            x = float(kin.coordinates[after])
-            a, b = spec.mesh(rule, rule.a, state), spec.mesh(rule, rule.b, state)
-            scene.set_pose(a, kin.pose(rule.a, x))
-            scene.set_pose(b, kin.pose(rule.b, x))
-            xs.append(x)
-            cs.append(-BISECT_MM if scene.collide(a, b) else scene.distance(a, b).distance)
-        certificates[rule.key] = _certified(scene, spec, rule, state, xs, cs)
+    cuts.clear()
+    certificates = _certificates(scene, spec, state, indices, clearance, after)
     return {"indices": list(indices), "clearance": clearance, "overlap_mm": overlap_mm,
             "overlap_unit": overlap_unit, "points": points, "play": play, "queries": scene.queries,
             "play_s": play_s, "seconds": time.perf_counter() - start, "certificates": certificates}
