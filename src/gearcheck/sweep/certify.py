@@ -246,3 +246,71 @@ def refine_least_many(curves: Sequence[tuple[Sequence[float], Sequence[float]]],
             if mine:
                 c.add([asked[i][1] for i in mine], values[mine])
     return [c.result(precision) for c in cycles]
+
+
+# A figure's certified minimum is sharpened to this (mm) below the least measured value beside it
+# (report precision), with at most SHARPEN more measurements per item and SHARPEN_ITEMS items.
+PRECISION_MM = 1e-4
+SHARPEN = 48
+SHARPEN_ITEMS = 3
+
+
+@dataclass
+class FigureCertificate:
+    """One figure over many items (a chain's links or rollers): the least certified bound, where
+    (item, angle interval in rad), the least measured value, the refinements, and the intervals
+    left undecided (item, a0, a1)."""
+
+    certified_min: float = math.inf
+    sampled_min: float = math.inf
+    link: int = -1
+    between_rad: tuple[float, float] = (math.nan, math.nan)
+    refined: int = 0
+    undecided: list[tuple[int, float, float]] = field(default_factory=list)
+    item: str = "link"
+
+    def as_dict(self, prefix: str) -> dict:
+        return {f"{prefix}certified_min_mm": self.certified_min, f"{prefix}sampled_min_mm": self.sampled_min,
+                f"{prefix}certified_min_{self.item}": self.link,
+                f"{prefix}certified_min_between_deg": [math.degrees(a) for a in self.between_rad],
+                f"{prefix}intervals_refined": self.refined, f"{prefix}undecided_intervals": len(self.undecided)}
+
+
+def certify_figure(angles: np.ndarray, values: np.ndarray, requirement: float, measure: Callable[[int, float], float],
+                   path: Callable[[int, float, float], float], resolution_mm: float, floor_mm: float,
+                   item: str = "link", sharpen_items: int = SHARPEN_ITEMS) -> FigureCertificate:
+    """One figure (``values[:, i]`` at ``angles``, item i) certified for every item: ≥ ``requirement``
+    over the continuous motion, refined by ``measure(i, angle)``, ``path(i, a0, a1)`` the longest
+    path of a point of item i over [a0, a1]; a value that is not finite (nothing within the model's
+    reach) counts as ``floor_mm``, a lower bound of it. Then the figure itself is sharpened: the
+    item holding the least bound is certified again with its least piece split to
+    :data:`PRECISION_MM` (the next item's, if it then holds the least; at most ``sharpen_items``)."""
+    xs = [float(a) for a in angles]
+    refined, sampled = 0, math.inf
+
+    def finite(v: float) -> float:
+        return float(v) if math.isfinite(v) else floor_mm
+
+    def run(i: int, sharpen: int) -> Certificate:
+        nonlocal refined, sampled
+        cert = certify(xs, [finite(v) for v in values[:, i]], lambda x: finite(measure(i, x)),
+                       lambda a0, a1: path(i, a0, a1), requirement, resolution_mm, precision=PRECISION_MM,
+                       sharpen=sharpen)
+        refined += cert.refined
+        sampled = min(sampled, cert.sampled_min)
+        return cert
+
+    certs = {i: run(i, 0) for i in range(values.shape[1])}
+    sharpened: set[int] = set()
+    while True:
+        worst = min(certs, key=lambda k: certs[k].certified_min)
+        if worst in sharpened or len(sharpened) >= sharpen_items:
+            break
+        sharpened.add(worst)
+        certs[worst] = run(worst, SHARPEN)
+    out = FigureCertificate(refined=refined, sampled_min=sampled, item=item)
+    for i, cert in certs.items():
+        out.undecided += [(i, u[0], u[1]) for u in cert.undecided]
+    out.link = worst
+    out.certified_min, out.between_rad = certs[worst].certified_min, certs[worst].at
+    return out

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 
 from gearcheck.geometry import iso606_chains
 from gearcheck.geometry import roller_chain as rc
+from gearcheck.mechanisms.roller_chain.certified import CERTIFIED
 from gearcheck.results import Comparison, Level, Plot, Report, Series, SweepOutcome, Verdict
 
 # The sweep's speed ripple and chordal rise must equal the closed forms within these (the gauge
@@ -19,31 +20,49 @@ RISE_TOL_MM = 1e-6
 WEAR_MARGIN = 0.10
 
 
+CERTIFIED_SHORT = "over the continuous motion"
+
+
+def _where(cert) -> str:
+    """Where a roller certificate's least bound lies, in words."""
+    a0, a1 = (math.degrees(a) for a in cert.between_rad)
+    return f"roller {cert.link} between θ = {a0:.3f}° and {a1:.3f}°"
+
+
 def chain_verdicts(outcome: SweepOutcome) -> list[Verdict]:
     d, s = outcome.data, outcome.summary
     m, ex = d.model, s["exact"]
     resolves = outcome.mesh_resolves
     out = []
     collisions = s["collisions"]
+    cert = d.certified
+    rollers_c, plates_c = cert.least(resolves)
+    ex_rollers_c, ex_plates_c = cert.exact_rollers.certified_min, cert.exact_plates.certified_min
+    read = "meshes" if resolves else "exact model (the meshes cannot resolve the clearances)"
     out.append(Verdict.of(
         "no_interference", "no roller, plate or pin meets the sprocket at any pose",
-        collisions == 0 and ex["min_roller_clearance_mm"] > 0 and ex["min_plate_distance_mm"] > 0,
-        f"{collisions} colliding link poses of {s['poses'] * s['links']}",
-        {"collisions": collisions}, evidence="mesh sweep (FCL collide at every pose and link) and the exact model",
-        shortfall=f"{collisions} link poses collide, required 0"))
+        collisions == 0 and min(rollers_c, plates_c) >= 0 and min(ex_rollers_c, ex_plates_c) > 0,
+        f"{collisions} colliding link poses of {s['poses'] * s['links']}; certified over the continuous motion: "
+        f"rollers ≥ {rollers_c:.4f} mm, plates ≥ {plates_c:.4f} mm ({read}; exact ≥ {ex_rollers_c:.4f} / "
+        f"{ex_plates_c:.4f} mm)",
+        {"collisions": collisions, "certified_roller_min_mm": rollers_c, "certified_plate_min_mm": plates_c},
+        evidence=f"mesh sweep (FCL collide at every pose and link) and the exact model, {CERTIFIED}",
+        shortfall=(f"{collisions} link poses collide, required 0" if collisions else
+                   f"certified least clearance {min(rollers_c, plates_c, ex_rollers_c, ex_plates_c):.4f} mm, "
+                   "required > 0")))
     engaging = s["min_engaging_roller_clearance_mm"] if resolves else ex["min_engaging_roller_clearance_mm"]
-    fine = ex["min_engaging_roller_clearance_fine_mm"]
+    where = _where(cert.rollers if resolves else cert.exact_rollers)
     out.append(Verdict.of(
         "roller_tooth_clearance", "rollers swing into and out of their seats clear of the teeth",
-        engaging > 0 and fine > 0,
-        f"least clearance of a roller off its seat {engaging:.4f} mm at the sweep's poses (exact "
-        f"{ex['min_engaging_roller_clearance_mm']:.4f} mm); exact model on {ex['fine_steps_per_cycle']} poses per "
-        f"pitch {fine:.4f} mm (a landing roller tends to ri − d1/2)",
-        {"min_engaging_roller_clearance_mm": engaging, "exact_fine_mm": fine},
+        rollers_c > 0 and ex_rollers_c > 0,
+        f"least roller–tooth clearance {rollers_c:.4f} mm {CERTIFIED_SHORT} ({where}; exact model "
+        f"{ex_rollers_c:.4f} mm); off its seat {engaging:.4f} mm at the sweep's poses (a landing roller tends to "
+        "ri − d1/2)",
+        {"certified_min_roller_clearance_mm": rollers_c, "exact_certified_min_mm": ex_rollers_c,
+         "min_engaging_roller_clearance_mm": engaging},
         evidence=("mesh sweep (FCL distance, every roller, every pose)" if resolves
-                  else "exact model (exact arcs): the meshes cannot resolve the clearance")
-        + "; the exact model between the sweep's poses",
-        shortfall=f"least clearance {min(engaging, fine):.4f} mm, required > 0"))
+                  else "exact model (exact arcs): the meshes cannot resolve the clearance") + f", {CERTIFIED}",
+        shortfall=f"least clearance {min(rollers_c, ex_rollers_c):.4f} mm ({where}), required > 0"))
     seated = s["min_seated_roller_clearance_mm"]
     out.append(Verdict.of(
         "rollers_seat", "every seated roller sits in its seating arc, concentric, ri − d1/2 clear",
@@ -53,14 +72,14 @@ def chain_verdicts(outcome: SweepOutcome) -> list[Verdict]:
         {"seating_clearance_mm": m.seating_clearance_mm, "min_seated_mm": seated},
         evidence="exact model (roller on the seating centre), measured on the mesh sweep",
         shortfall=f"seated clearance {seated:.4f} mm against ri − d1/2 = {m.seating_clearance_mm:.4f} mm"))
-    plate = s["min_plate_distance_mm"] if resolves else ex["min_plate_distance_mm"]
     out.append(Verdict.of(
-        "plates_clear_teeth", "link plates clear the tooth sides (and the hub)", plate > 0,
-        f"least plate–sprocket distance {plate:.4f} mm (exact {ex['min_plate_distance_mm']:.4f} mm: axial gap "
+        "plates_clear_teeth", "link plates clear the tooth sides (and the hub)", plates_c > 0,
+        f"least plate–sprocket distance {plates_c:.4f} mm {CERTIFIED_SHORT} (exact {ex_plates_c:.4f} mm: axial gap "
         f"(b1 − bf1)/2 = {m.inner_plate_gap_mm:.4f} mm" + (f", hub {m.hub_gap_mm:.4f} mm)" if m.strands > 1 else ")"),
-        {"min_plate_distance_mm": plate},
-        evidence="mesh sweep (FCL distance, every link)" if resolves else "exact model (axial gap, hub)",
-        shortfall=f"least plate distance {plate:.4f} mm, required > 0"))
+        {"min_plate_distance_mm": plates_c},
+        evidence=("mesh sweep (FCL distance, every link)" if resolves else "exact model (axial gap, hub)")
+        + f", {CERTIFIED}",
+        shortfall=f"least plate distance {plates_c:.4f} mm, required > 0"))
     allowed, ripple = m.max_speed_ripple_pct, 100.0 * d.ripple
     out.append(Verdict.graded(
         "speed_ripple", "the polygon effect's speed ripple within what the application allows",

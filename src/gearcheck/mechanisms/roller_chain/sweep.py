@@ -32,9 +32,11 @@ import numpy as np
 from gearcheck.geometry import roller_chain as rc
 from gearcheck.mechanism import Assembly, SweepPlan
 from gearcheck.mechanisms.roller_chain.assembly import INNER, OUTER, SPROCKET, link_name
+from gearcheck.mechanisms.roller_chain.certified import ChainCertificates, certify_chain
 from gearcheck.mechanisms.roller_chain.model import RollerChainModel
 from gearcheck.results import SweepOutcome, WorstPose
 from gearcheck.sweep.bodies import Body, MeshData, pair_error_bound, submesh
+from gearcheck.sweep.engine import Scene
 
 # Sprocket angles per tooth pitch (even: the handovers and the mid-pitch poses are on the grid). A
 # seated roller moves R·2π/(16z) ≈ p/16 per step, far less than its radius d1/2 ≈ p/3, so no body
@@ -43,9 +45,6 @@ STEPS_PER_CYCLE = 16
 CYCLES = 2
 DEFAULT_OPTIONS = {"steps_per_cycle": STEPS_PER_CYCLE}
 SPEED_EPS_CYCLES = 1e-4
-# The exact model's own pass for the least clearance of a roller off its seat (the mesh's poses may
-# step over the closest approach of a roller swinging in): this many poses per tooth pitch.
-FINE_STEPS_PER_CYCLE = 256
 AXIS_MARGIN_MM = 1e-4
 COLLIDE_SKIP_MM = 1e-3
 GAUGE_CLEAR_MM = 50.0
@@ -158,6 +157,7 @@ class _Setup:
     bound: float
     started: float
     meshes: list
+    scene: Scene  # the reduce step's own (the certificates' distance queries); BVHs built on first use
 
 
 def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None = None) -> SweepPlan:
@@ -176,7 +176,7 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
                 pair_error_bound(dict(bodies), SPROCKET, link_name(1)))
     angles = sweep_angles(wrap, int(opts["steps_per_cycle"]))
     tasks = [(evaluate_pose, (wrap, float(a))) for a in angles]
-    setup = _Setup(model, angles, bound, time.perf_counter(), meshes)
+    setup = _Setup(model, angles, bound, time.perf_counter(), meshes, Scene(meshes))
     return SweepPlan(meshes, tasks, functools.partial(reduce_sweep, setup), options=opts)
 
 
@@ -207,7 +207,7 @@ class ChainSweep:
     wear: rc.WearLimit
     replacement_pct: float
     replacement_rule: str
-    fine_engaging: float  # exact model, FINE_STEPS_PER_CYCLE poses per pitch
+    certified: ChainCertificates  # both figures over the continuous motion (:mod:`.certified`)
 
 
 def _origin_to_segment(a: np.ndarray, b: np.ndarray) -> float:
@@ -217,24 +217,61 @@ def _origin_to_segment(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.hypot(*(a + t * ab)))
 
 
-def exact_tables(model: RollerChainModel, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(roller clearances, plate distances, top-span speed) of the exact model at the angles."""
+def exact_at(model: RollerChainModel, a: float) -> tuple[np.ndarray, np.ndarray]:
+    """(roller clearances, plate distances) of the exact model at drive angle ``a``; a plate's
+    distance where the plate overlaps the teeth in plan (else NaN: not compared)."""
     wrap, gap, r = model.wrap, model.gap, model.roller_radius_mm
     h = model.size.plate_depth_mm / 2.0
-    rollers = np.array([rc.roller_clearances(gap, wrap, float(a), r) for a in angles])
-    plates = np.full((len(angles), wrap.links), np.nan)
-    for i, a in enumerate(angles):
-        c = wrap.centres(float(a))
-        for j in range(wrap.links):
-            # the plate overlaps the tooth row in plan when an end's axis lies within h2/2 of the
-            # outline (the roller, r < h2/2, is outside the teeth): then the plates face the tooth
-            # sides across the axial gap; the hub (multi-strand) lies under the chord's middle
-            if min(rollers[i, j], rollers[i, j + 1]) + r < h:
-                hub = (_origin_to_segment(c[j], c[j + 1]) - h - model.sprocket.hub_radius_mm
-                       if model.strands > 1 else math.inf)
-                plates[i, j] = min(model.plate_gap_mm(j), hub)
-    speed = np.array([wrap.top_speed_ratio(float(a)) for a in angles])
-    return rollers, plates, speed
+    rollers = rc.roller_clearances(gap, wrap, a, r)
+    plates = np.full(wrap.links, np.nan)
+    c = wrap.centres(a)
+    for j in range(wrap.links):
+        # the plate overlaps the tooth row in plan when an end's axis lies within h2/2 of the
+        # outline (the roller, r < h2/2, is outside the teeth): then the plates face the tooth
+        # sides across the axial gap; the hub (multi-strand) lies under the chord's middle
+        if min(rollers[j], rollers[j + 1]) + r < h:
+            hub = (_origin_to_segment(c[j], c[j + 1]) - h - model.sprocket.hub_radius_mm
+                   if model.strands > 1 else math.inf)
+            plates[j] = min(model.plate_gap_mm(j), hub)
+    return rollers, plates
+
+
+def exact_tables(model: RollerChainModel, angles: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(roller clearances, plate distances, top-span speed) of the exact model at the angles."""
+    at = [exact_at(model, float(a)) for a in angles]
+    speed = np.array([model.wrap.top_speed_ratio(float(a)) for a in angles])
+    return np.array([r for r, _ in at]), np.array([p for _, p in at]), speed
+
+
+def _certify(setup: _Setup, rollers: np.ndarray, plates: np.ndarray, ex_rollers: np.ndarray,
+             ex_plates: np.ndarray) -> ChainCertificates:
+    """Every roller's clearance and every link's plate distance certified over the continuous
+    motion (:mod:`.certified`): on the meshes (distance queries in this process) and on the exact
+    model."""
+    model, scene, wrap = setup.model, setup.scene, setup.model.wrap
+    names = {(0, 0): ROLLER_A, (0, 1): ROLLER_B, (1, 0): INNER_PLATES, (1, 1): OUTER_PLATES}
+
+    def mesh_measure(figure: int, i: int, a: float) -> float:
+        link = i - i % 2 if figure == 0 else i  # a roller: its inner link (roller a even, b odd)
+        name = names[(figure, i % 2)]
+        scene.set_pose(SPROCKET, wrap.sprocket_matrix(a))
+        scene.set_pose(name, wrap.link_matrices(a)[link])
+        return scene.distance(SPROCKET, name).distance
+
+    @functools.lru_cache(maxsize=64)
+    def exact(a: float) -> tuple[np.ndarray, np.ndarray]:
+        return exact_at(model, a)
+
+    def exact_measure(figure: int, i: int, a: float) -> float:
+        return float(exact(a)[figure][i])
+
+    roller = max(float(np.hypot(m.vertices[:, 0] - x, m.vertices[:, 1]).max())
+                 for m, x in ((setup.meshes[1], 0.0), (setup.meshes[2], wrap.pitch_mm)))
+    plate = max(float(np.hypot(m.vertices[:, 0], m.vertices[:, 1]).max()) for m in setup.meshes[3:5])
+    gaps = np.array([min(model.plate_gap_mm(j), model.hub_gap_mm) for j in range(wrap.links)])
+    return certify_chain(wrap, setup.angles, (rollers, plates), (ex_rollers, ex_plates), mesh_measure,
+                         exact_measure, (max(roller, model.roller_radius_mm), plate), setup.bound, float(gaps.min()),
+                         gaps)
 
 
 def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
@@ -261,14 +298,13 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     ripple = float(1.0 - speed.min() / speed.max())
     rise = float(height.max() - height.min())
     replacement, rule = rc.replacement_limit_pct(model.teeth, model.fixed_centres)
-    fine = sweep_angles(wrap, FINE_STEPS_PER_CYCLE)
-    fine_engaging = min(float(np.min(rc.roller_clearances(model.gap, wrap, float(a), model.roller_radius_mm)
-                                     [~wrap.seated(float(a))], initial=np.inf)) for a in fine)
+    certified = _certify(setup, rollers, plates, ex_rollers, ex_plates)
     data = ChainSweep(model, angles, rollers, plates, hits, seated, ex_rollers, ex_plates, height, speed, ex_speed,
                       bound, roller_dev, plate_dev, ripple, rise, sweep_s,
-                      rc.wear_limit(model.gap, model.roller_radius_mm), replacement, rule, fine_engaging)
+                      rc.wear_limit(model.gap, model.roller_radius_mm), replacement, rule, certified)
     worst = _worst_poses(data)
-    timings = {"sweep_s": sweep_s, "sprocket_poses": len(angles), "poses_per_s": len(angles) / max(sweep_s, 1e-9)}
+    timings = {"sweep_s": sweep_s, "sprocket_poses": len(angles), "poses_per_s": len(angles) / max(sweep_s, 1e-9),
+               "certify_s": certified.seconds}
     return SweepOutcome(summary(data), worst, timings, data)
 
 
@@ -312,8 +348,6 @@ def summary(d: ChainSweep) -> dict:
             "min_roller_clearance_mm": float(d.ex_rollers.min()),
             "seated_roller_clearance_mm": m.seating_clearance_mm,
             "min_engaging_roller_clearance_mm": _min(d.ex_rollers, moving),
-            "min_engaging_roller_clearance_fine_mm": d.fine_engaging,
-            "fine_steps_per_cycle": FINE_STEPS_PER_CYCLE,
             "min_plate_distance_mm": float(np.nanmin(d.ex_plates)),
             "speed_ripple_pct": 100.0 * rc.speed_ripple(m.teeth),
             "chordal_rise_mm": rc.chordal_rise(wrap.pitch_mm, m.teeth),
@@ -336,4 +370,5 @@ def summary(d: ChainSweep) -> dict:
         "step_deg": math.degrees(float(d.angles[1] - d.angles[0])),
         "seated_rollers_min": int(d.seated.sum(axis=1).min()),
         "seated_rollers_max": int(d.seated.sum(axis=1).max()),
+        "certified": d.certified.summary(),
     }

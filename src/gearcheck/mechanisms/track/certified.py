@@ -29,21 +29,18 @@ outline's sagitta.
 from __future__ import annotations
 
 import math
+import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from gearcheck.geometry import track_chain as tc
-from gearcheck.sweep.certify import Certificate, certify
+from gearcheck.geometry.wrap_path import wrap_path_mm
+from gearcheck.sweep.certify import FigureCertificate, certify_figure
 
 # The figures, their index in the sweep's (and the exact table's) last axis.
 SLEEVE_FIGURE, PLATE_FIGURE = 0, 1
-# Each figure's certified minimum is sharpened to this (mm) below the least measured clearance
-# beside it (report precision), with at most SHARPEN more measurements per figure.
-PRECISION_MM = 1e-4
-SHARPEN = 48
-SHARPEN_LINKS = 3  # links sharpened at most, per figure
 # How a verdict read from the certificates names its evidence.
 CERTIFIED = ("certified over the continuous motion (each interval between swept angles bounded by its ends' "
              "clearances and the longest path of a link point relative to the sprocket, refined by distance "
@@ -83,84 +80,8 @@ def link_path_mm(wrap: tc.ChainWrap, link: int, a0: float, a1: float, reach_mm: 
     ``round_mm`` of itself, which counts as a path of 2·round_mm (c ≥ c_end − round_mm, a weaker
     use of the same bound)."""
     lo, hi = sorted((a0, a1))
-    cuts = [lo, *_events(wrap, lo, hi), hi]
-    p = wrap.pitch_mm
-    path, turns_round = 0.0, False
-    for b0, b1 in zip(cuts[:-1], cuts[1:], strict=True):
-        if not b1 > b0:
-            continue
-        seated = wrap.seated_pins(0.5 * (b0 + b1))
-        if seated[link] and seated[link + 1]:
-            continue
-        idx = np.flatnonzero(seated)
-        first, last = int(idx[0]), int(idx[-1])
-        rho = (link - last) * p if link >= last else (first - link) * p  # to the run's pivot pin
-        if rho == 0.0 and round_mm is not None:
-            turns_round = True
-        else:
-            path += (b1 - b0) * (rho + reach_mm)
-    return path + (2.0 * round_mm if turns_round and round_mm is not None else 0.0)
-
-
-@dataclass
-class FigureCertificate:
-    """One figure over every link: the least certified bound, where (link, angle interval in rad),
-    the least measured value, the refinements, and the intervals left undecided (link, a0, a1)."""
-
-    certified_min: float = math.inf
-    sampled_min: float = math.inf
-    link: int = -1
-    between_rad: tuple[float, float] = (math.nan, math.nan)
-    refined: int = 0
-    undecided: list[tuple[int, float, float]] = field(default_factory=list)
-
-    def as_dict(self, prefix: str) -> dict:
-        return {f"{prefix}certified_min_mm": self.certified_min, f"{prefix}sampled_min_mm": self.sampled_min,
-                f"{prefix}certified_min_link": self.link,
-                f"{prefix}certified_min_between_deg": [math.degrees(a) for a in self.between_rad],
-                f"{prefix}intervals_refined": self.refined, f"{prefix}undecided_intervals": len(self.undecided)}
-
-
-def certify_figure(wrap: tc.ChainWrap, angles: np.ndarray, values: np.ndarray, requirement: float,
-                   measure: Callable[[int, float], float], reach_mm: float, resolution_mm: float,
-                   floor_mm: float, round_mm: float | None = None) -> FigureCertificate:
-    """One figure (``values[:, link]`` at ``angles``) certified for every link: clearance ≥
-    ``requirement`` over the continuous motion, refined by ``measure(link, angle)``; a value that
-    is not finite (nothing within the model's reach) counts as ``floor_mm``, a lower bound of it.
-    Then the figure itself is sharpened: the link holding the least bound is certified again with
-    its least piece split to :data:`PRECISION_MM` (the next link's, if it then holds the least)."""
-    xs = [float(a) for a in angles]
-    refined, sampled = 0, math.inf
-
-    def run(link: int, sharpen: int) -> Certificate:
-        nonlocal refined, sampled
-        cs = [_finite(v, floor_mm) for v in values[:, link]]
-        cert = certify(xs, cs, lambda x: _finite(measure(link, x), floor_mm),
-                       lambda a0, a1: link_path_mm(wrap, link, a0, a1, reach_mm, round_mm), requirement,
-                       resolution_mm,
-                       precision=PRECISION_MM, sharpen=sharpen)
-        refined += cert.refined
-        sampled = min(sampled, cert.sampled_min)
-        return cert
-
-    certs = {link: run(link, 0) for link in range(values.shape[1])}
-    sharpened: set[int] = set()
-    while True:
-        worst = min(certs, key=lambda k: certs[k].certified_min)
-        if worst in sharpened or len(sharpened) >= SHARPEN_LINKS:
-            break
-        sharpened.add(worst)
-        certs[worst] = run(worst, SHARPEN)
-    out = FigureCertificate(refined=refined, sampled_min=sampled)
-    for link, cert in certs.items():
-        out.undecided += [(link, u[0], u[1]) for u in cert.undecided]
-    out.link = worst
-    out.certified_min, out.between_rad = certs[worst].certified_min, certs[worst].at
-    return out
-
-
-def _finite(v: float, floor: float) -> float:
-    return float(v) if math.isfinite(v) else floor
+    return wrap_path_mm(wrap.seated_pins, [lo, *_events(wrap, lo, hi), hi], link, wrap.pitch_mm, reach_mm,
+                        round_mm)
 
 
 def reach_xy(vertices: np.ndarray) -> float:
@@ -230,8 +151,6 @@ def certify_track(wrap: tc.ChainWrap, angles: np.ndarray, mesh: tuple[np.ndarray
     figure's part of the link, its farthest point from the pin axis; ``link_error_mm``: the link
     mesh's own error bound (how far its sleeve is from round); ``slack_mm``: a requirement holds
     to within this (the verdicts compare at report precision: half of it)."""
-    import time
-
     t0 = time.perf_counter()
     out: dict[str, FigureCertificate] = {}
     for label, values, measure, resolution in (("", mesh, mesh_measure, resolution_mm[0]),
@@ -240,9 +159,9 @@ def certify_track(wrap: tc.ChainWrap, angles: np.ndarray, mesh: tuple[np.ndarray
                 label=label) -> FigureCertificate:
             # the sleeve is round about its pin: the model's own error (the exact circle: none)
             round_mm = (link_error_mm if label == "" else 0.0) if figure == SLEEVE_FIGURE else None
-            return certify_figure(wrap, angles, values[figure], requirement,
-                                  lambda link, a: measure(figure, link, a), reach_mm[figure], resolution, floor_mm,
-                                  round_mm)
+            return certify_figure(angles, values[figure], requirement, lambda link, a: measure(figure, link, a),
+                                  lambda link, a0, a1: link_path_mm(wrap, link, a0, a1, reach_mm[figure], round_mm),
+                                  resolution, floor_mm)
 
         out[f"{label}sleeve"] = run(SLEEVE_FIGURE, -slack_mm)
         out[f"{label}plate"] = run(PLATE_FIGURE, least_gap_mm - slack_mm)
