@@ -111,3 +111,23 @@ def test_coarse_verdicts_equal_the_fine_grids(coarse):
     cert = _track(result)["certified"]
     assert cert["sleeve_certified_min_mm"] <= cert["sleeve_sampled_min_mm"]
     assert cert["plate_certified_min_mm"] <= cert["plate_sampled_min_mm"]
+
+
+def test_the_worn_chain_is_certified_too(coarse):
+    from gearcheck.mechanisms.track.clearance import exact_table, sweep_angles, worn_model
+
+    model, result = coarse
+    track = _track(result)
+    worn = worn_model(model)
+    assert worn is not None  # the template declares a chain wear
+    cert = track["wear"]["mesh_declared_certified"]
+    fine = exact_table(worn, sweep_angles(worn.wrap, FINE))
+    sleeve, plate = float(fine[..., 0].min()), float(fine[..., 1].min())
+    bound = track["mesh_error_bound_mm"]
+    assert cert["exact_sleeve_certified_min_mm"] <= sleeve + 1e-12
+    assert cert["exact_plate_certified_min_mm"] <= plate + 1e-12
+    assert cert["sleeve_certified_min_mm"] <= sleeve + bound and cert["plate_certified_min_mm"] <= plate + bound
+    assert cert["exact_sleeve_certified_min_mm"] >= sleeve - 0.02  # sharpened: the figure that decides
+    wear = next(v for v in result.verdicts if v.name == "chain_wear_within_limit")
+    assert (wear.level == "pass") == (sleeve >= 0.0 and plate >= 0.0 and track["wear"]["declared_seats"] == 1)
+    assert "certified over the continuous motion" in wear.measured

@@ -228,6 +228,7 @@ class TrackSweep:
     wear: track_wear.WearLimit | None = None  # the chain-wear limit (exact 2-D model), see :mod:`.wear`
     worn_mesh: WornMesh | None = None  # the mesh sweep of the chain at the declared worn pitch
     certified: TrackCertificates | None = None  # both figures over the continuous motion (:mod:`.certified`)
+    worn_certified: TrackCertificates | None = None  # the same for the chain at the declared worn pitch
 
     @property
     def collisions(self) -> int:
@@ -345,13 +346,17 @@ def _worn_mesh(results: list, exact: np.ndarray | None, reach_mm: float) -> Worn
                     float(ex_sleeve.min()), float(ex_plate.min()), float(max(dev_sleeve.max(), dev_plate.max())))
 
 
-def _certify(setup: _Setup, sleeve_d: np.ndarray, plate_d: np.ndarray, table: np.ndarray) -> TrackCertificates:
+def _certify(setup: _Setup, sleeve_d: np.ndarray, plate_d: np.ndarray, table: np.ndarray,
+             model: TrackModel | None = None) -> TrackCertificates:
     """Both figures of every link certified over the continuous motion (:mod:`.certified`), on the
     meshes (distance queries in this process where an interval does not decide) and on the exact
-    2-D model; the requirements: no interference for the sleeve, the least tip gap for the plate,
+    2-D model; the requirements: no interference for the sleeve, the least tip gap for the plate
+    (``model``: the chain at the declared worn pitch instead, against no interference alone),
     each at report precision (as the verdicts read them: to half of :data:`WINDOW_ROUNDING_MM`),
     the exact model refined down to that too."""
-    model, scene, angles = setup.model, setup.scene, setup.angles
+    worn = model is not None
+    model = setup.model if model is None else model
+    scene, angles = setup.scene, setup.angles
     exact = exact_section(model)
     wrap = model.wrap
     names = (SLEEVE, PLATE)
@@ -366,7 +371,7 @@ def _certify(setup: _Setup, sleeve_d: np.ndarray, plate_d: np.ndarray, table: np
 
     reach = (reach_xy(setup.meshes[1].vertices), reach_xy(setup.meshes[2].vertices))
     return certify_track(wrap, angles, (sleeve_d, plate_d), (table[..., 0], table[..., 1]),
-                         model.required_gap_min_mm, mesh_measure, exact_measure, reach,
+                         0.0 if worn else model.required_gap_min_mm, mesh_measure, exact_measure, reach,
                          (setup.bound, 0.5 * WINDOW_ROUNDING_MM), exact.reach_mm, setup.link_bound,
                          0.5 * WINDOW_ROUNDING_MM)
 
@@ -401,6 +406,10 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
 
     pr = _proofs(setup, x, sleeve_seated)
     certified = _certify(setup, sleeve_d, plate_d, table)
+    worn_certified = None
+    if setup.worn_model is not None and worn_table is not None:
+        worn_out = np.array(results[len(angles):])
+        worn_certified = _certify(setup, worn_out[..., 0], worn_out[..., 1], worn_table, setup.worn_model)
     min_sleeve, min_plate = x["min_sleeve"], x["min_plate"]
     s_sl, pose_sl, s_pl, pose_pl = pr["s_sl"], pr["pose_sl"], pr["s_pl"], pr["pose_pl"]
     gap_proof, sleeve_proof, gap_point_link = pr["gap_proof"], pr["sleeve_proof"], pr["gap_point_link"]
@@ -414,7 +423,8 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
                       gap_point_link, float(whole_link_at_sleeve), model_gap, len(setup.meshes[1].faces),
                       len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s,
                       wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation, tables=tables),
-                      worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm), certified=certified)
+                      worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm), certified=certified,
+                      worn_certified=worn_certified)
     worst = [
         WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
                   names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),
@@ -424,7 +434,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
     swept = len(results)  # sprocket poses swept: the new chain's and, where declared, the worn chain's
     timings = {"sweep_s": sweep_s, "sprocket_poses": swept, "poses_per_s": swept / sweep_s,
                "link_poses_per_s": swept * wrap.links / sweep_s, "contact_proof_s": proof_s,
-               "certify_s": certified.seconds}
+               "certify_s": certified.seconds + (0.0 if worn_certified is None else worn_certified.seconds)}
     return SweepOutcome(summary(data), worst, timings, data)
 
 
@@ -491,14 +501,16 @@ def summary(d: TrackSweep) -> dict:
         "seated_links_max": int(seated_counts.max()),
         "min_at_seated_links": int(x["ex_off_plate"].value >= x["ex_seated_gap"].value - WINDOW_ROUNDING_MM
                                    and x["ex_off_sleeve"].value >= x["ex_seated_sleeve"].value - WINDOW_ROUNDING_MM),
-        **({} if d.wear is None else wear_summary(d.wear, d.worn_mesh, d.bound)),
+        **({} if d.wear is None else wear_summary(d.wear, d.worn_mesh, d.bound, d.worn_certified)),
         **({} if d.certified is None else {"certified": d.certified.summary()}),
     }
 
 
-def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: float = 0.0) -> dict:
+def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: float = 0.0,
+                 certified: TrackCertificates | None = None) -> dict:
     """summary.json's wear figures (exact 2-D model; the mode as its index in ``track_wear.MODES``)
-    and, when the declared wear is above zero, the mesh sweep of the worn chain."""
+    and, when the declared wear is above zero, the mesh sweep of the worn chain and its clearances
+    certified over the continuous motion."""
     mesh = {} if worn is None else {
         "mesh_declared_poses": worn.poses,
         "mesh_declared_collisions": worn.collisions,
@@ -509,6 +521,7 @@ def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: f
         "mesh_declared_max_deviation_mm": worn.max_dev,
         "mesh_confirms_declared_sweep": int(worn.collisions == 0 and worn.max_dev <= bound
                                             and min(worn.exact_min_sleeve_mm, worn.exact_min_plate_mm) >= 0.0),
+        **({} if certified is None else {"mesh_declared_certified": certified.summary()}),
     }
     return {
         "wear_limit_pct": 100.0 * w.limit,

@@ -5,6 +5,8 @@ then), and the mesh sweep against the exact 2-D model."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from gearcheck.mechanisms.track.certified import CERTIFIED, decided
@@ -105,7 +107,7 @@ def track_verdicts(outcome: SweepOutcome) -> list[Verdict]:
                     "seat_contact_mm": sleeve_proof.contact_mm, "seat_measured_mm": sleeve_proof.measured_mm,
                     "tolerance_mm": d.contact_tol, "bound_mm": bound},
                    evidence="mesh sweep (FCL: pushed by the gap ∓ tolerance)", shortfall=proof_short),
-        *_wear_verdicts(d),
+        *_wear_verdicts(d, resolved),
         *tooth_count_verdicts(model.gap.teeth),
         Verdict.of("mesh_agrees_with_exact", "mesh sweep agrees with the exact 2-D model at every pose and link",
                    agrees, f"max |mesh − exact| = {d.max_dev:.4f} mm"
@@ -157,30 +159,36 @@ def tooth_count_verdicts(teeth: int) -> list[Verdict]:
                   f"({teeth - 1} or {teeth + 1}) shares it among all teeth")]
 
 
-def _wear_verdicts(d: TrackSweep) -> list[Verdict]:
+def _wear_verdicts(d: TrackSweep, resolved: bool = True) -> list[Verdict]:
     """The declared chain wear within the limit at which a link first fails to seat."""
     w = d.wear
     if w is None:
         return []
     seat = "seats" if w.declared_seat.ok else f"does not seat ({MODE_TEXT[w.declared_seat.mode]})"
     sweep = ("worn-pitch sweep clear" if w.declared_sweep.ok else "worn-pitch sweep meets the sprocket")
-    m = d.worn_mesh
+    m, cert = d.worn_mesh, d.worn_certified
     mesh = ("" if m is None else
             f"; mesh sweep of the worn chain: {m.collisions} collisions, min tooth–sleeve {m.min_sleeve_mm:.4f} mm, "
             f"min tip–plate {m.min_plate_mm:.4f} mm over {m.poses}×{d.model.wrap.links} link poses")
+    free, sleeve, plate = (True, math.inf, math.inf) if cert is None else cert.interference_free(resolved)
+    if cert is not None:
+        mesh += f"; certified over the continuous motion: tooth–sleeve ≥ {sleeve:.4f} mm, tip–plate ≥ {plate:.4f} mm"
     if not w.ok:
         short = (f"declared wear {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % (a link first fails to seat), "
                  f"over by {100 * (w.declared - w.limit):.4f} %")
+    elif m is not None and m.collisions:
+        short = f"the worn chain's mesh sweep collides at {m.collisions} poses, required none"
     else:
-        short = f"the worn chain's mesh sweep collides at {m.collisions if m is not None else 0} poses, required none"
+        short = (f"the worn chain meets the sprocket between the swept angles: certified tooth–sleeve ≥ {sleeve:.4f} "
+                 f"mm, tip–plate ≥ {plate:.4f} mm, required ≥ 0")
     return [Verdict.of(
         "chain_wear_within_limit", "declared chain wear ≤ the elongation at which a link first fails to seat",
-        w.ok and (m is None or m.collisions == 0),
+        w.ok and (m is None or m.collisions == 0) and free,
         f"declared {100 * w.declared:.3f} %, limit {100 * w.limit:.4f} % ({MODE_TEXT[w.mode]}; "
         f"{w.bracket_text()}); at the declared wear the sleeve {seat}, {sweep} "
         f"(exact 2-D model){mesh}",
         {"wear_elongation_pct": 100 * w.declared, "wear_limit_pct": 100 * w.limit,
          "wear_limit_mode": w.mode_code},
         evidence="exact model (2-D section: exact arcs, closed form or bisection on the elongation); mesh sweep at "
-                 "the declared wear",
+                 "the declared wear" + ("" if cert is None else f", {CERTIFIED}"),
         shortfall=short)]
