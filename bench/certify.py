@@ -1,6 +1,6 @@
 """What certifying the sweeps over the continuous motion costs (`make bench`, section "certify").
 
-The three templates' sweeps (the whole mechanism check on the meshes: plan, workers, reduce with
+The three templates' sweeps and the roller chain's (the whole mechanism check on the meshes: plan, workers, reduce with
 its certificates) on one worker, in a fresh process each, at the commit before the certified
 sweeps (:data:`PRE_CERTIFY_COMMIT`, checked out into a temporary worktree as bench/run.py does for
 its baseline) and on the current code, alternating; each figure is the median CPU seconds (the
@@ -27,10 +27,16 @@ def _cpu(runs: list[dict]) -> list[float | None]:
     return [r.get("runs", {}).get("jobs_1", {}).get("cpu_s") for r in runs if r.get("ok", True)]
 
 
+# Beside the three papers' templates: the roller chain's (certified too; the same template at both commits).
+MORE_TEMPLATES = {"roller_chain": "roller_chain_12B_z21"}
+
+
 def _probe(run_probe: Callable[[Any, list[str]], dict], mech: str) -> Callable[[Any], dict]:
     """The sweep probe of one template's mechanism on one worker, on a side."""
     def measure(side: Any) -> dict:
-        return run_probe(side, ["sweep", str(side.template(mech)), "--jobs", "1"])
+        template = (side.root / "templates" / f"{MORE_TEMPLATES[mech]}.toml" if mech in MORE_TEMPLATES
+                    else side.template(mech))
+        return run_probe(side, ["sweep", str(template), "--jobs", "1"])
 
     return measure
 
@@ -45,12 +51,13 @@ def bench_certify(repeat: int = 3) -> dict[str, Any]:
     with baseline_worktree(PRE_CERTIFY_COMMIT) as before:
         for side in (before, current):
             verify_and_warm(side)
-        steps = [Step(f"sweep_{m}", f"sweep {m} (1 worker)", _probe(run_probe, m)) for m in TEMPLATES]
+        mechs = [*TEMPLATES, *MORE_TEMPLATES]
+        steps = [Step(f"sweep_{m}", f"sweep {m} (1 worker)", _probe(run_probe, m)) for m in mechs]
         alternate([before, current], steps, repeat, raw)
         before_sha = before.commit
     out: dict[str, Any] = {"pre_certify_commit": PRE_CERTIFY_COMMIT, "pre_certify_sha": before_sha,
                            "current_commit": current.commit, "repeat": repeat}
-    for mech in TEMPLATES:
+    for mech in mechs:
         pre, cur = median(_cpu(raw["baseline"][f"sweep_{mech}"])), median(_cpu(raw["current"][f"sweep_{mech}"]))
         r = ratio(cur, pre)
         out[mech] = {"pre_certify_cpu_s": pre, "current_cpu_s": cur, "ratio": r, "target": f"≤ {RATIO_TARGET}×",
