@@ -19,7 +19,7 @@ from gearcheck.geometry.bisect import bisect
 from gearcheck.mechanisms.assembly.local import CUT_FACES, Cuts, to_local
 from gearcheck.mechanisms.assembly.sweep import BISECT_DEG, plan_sweep, sweep_poses
 from gearcheck.sweep.engine import Scene
-from step_pairs import template, write_pair
+from step_pairs import template, train_template, write_pair, write_train
 
 pytestmark = pytest.mark.cad
 
@@ -56,25 +56,32 @@ def planned(tmp_path_factory):
     return plan_sweep(built.assembly, built.bodies, None)
 
 
+def _plain_moves(planned, spec, indices: list[int]) -> np.ndarray:
+    """Each pose's moves both ways by the plain bisection on the whole directed meshes (any neighbour)."""
+    kin, part = spec.kin, spec.play
+    plain = Scene(planned.meshes)
+    out = np.full((len(indices), 2), np.nan)
+    for row, i in enumerate(indices):
+        x = float(kin.coordinates[i])
+        for column, sign in ((0, 1.0), (1, -1.0)):
+            pairs = [spec.play_meshes[(other, sign)] for other in spec.play_neighbours]
+            for other, (_, theirs) in zip(spec.play_neighbours, pairs, strict=True):
+                plain.set_pose(theirs, kin.pose(other, x))
+
+            def hits(d: float, x: float = x, sign: float = sign, pairs: list = pairs) -> bool:
+                for mine, _ in pairs:
+                    plain.set_pose(mine, kin.pose(part, x, sign * d))
+                return any(plain.collide(mine, theirs) for mine, theirs in pairs)
+            out[row, column] = bisect(hits, 0.0, spec.play_limit, BISECT_DEG, check_ends=False).touching
+    return out
+
+
 def test_every_move_is_the_plain_bisections_bracket(planned):
     spec = planned.tasks[0][1][0]
     indices = planned.tasks[0][1][2]
     scene = Counting(planned.meshes)
     out = sweep_poses(scene, spec, "as_built", indices, True)
-    kin, part = spec.kin, spec.play
-    (other,) = spec.play_neighbours
-    plain = Scene(planned.meshes)
-    for row, i in enumerate(indices):
-        x = float(kin.coordinates[i])
-        for column, sign in ((0, 1.0), (1, -1.0)):
-            mine, theirs = spec.play_meshes[(other, sign)]
-            plain.set_pose(theirs, kin.pose(other, x))
-
-            def hits(d: float, x: float = x, sign: float = sign, mine: str = mine, theirs: str = theirs) -> bool:
-                plain.set_pose(mine, kin.pose(part, x, sign * d))
-                return plain.collide(mine, theirs)
-            bracket = bisect(hits, 0.0, spec.play_limit, BISECT_DEG, check_ends=False)
-            assert out["play"][row, column] == bracket.touching, (i, sign)
+    assert np.array_equal(out["play"][:, :2], _plain_moves(planned, spec, indices))
     moves = 2 * len(indices)
     c = scene.counts
     # a cold start per sense (two whole queries, then the cuts); the rest between cuts
@@ -112,3 +119,20 @@ def test_to_local_inverts_a_pose():
     pose[:3, 3] = [1.0, 2.0, 3.0]
     p = np.array([0.5, -0.2, 0.7])
     assert to_local(pose, pose[:3, :3] @ p + pose[:3, 3]) == pytest.approx(p)
+
+
+def test_a_part_between_two_neighbours_is_bracketed_the_same(tmp_path):
+    """The middle gear of three, its play measured against both neighbours (a cut per neighbour and
+    sense): the moves are the plain bisection's, and each names the neighbour touched."""
+    step = write_train(tmp_path / "train.step", gears=3)
+    data = train_template(step, gears=3, tol_mm=0.005)
+    data["play"]["part"] = "gear_2"
+    built = pipeline.build(load(data), tmp_path / "run")
+    plan = plan_sweep(built.assembly, built.bodies, None)
+    spec, indices = plan.tasks[0][1][0], plan.tasks[0][1][2]
+    assert len(spec.play_neighbours) == 2
+    scene = Counting(plan.meshes)
+    out = sweep_poses(scene, spec, "as_built", indices, True)
+    assert np.array_equal(out["play"][:, :2], _plain_moves(plan, spec, indices))
+    assert np.all(np.isfinite(out["play"][:, 2:]))  # a neighbour touched each way
+    assert scene.counts["cut distance"] > 0

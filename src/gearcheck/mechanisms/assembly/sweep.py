@@ -177,6 +177,7 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
     suffix = "" if state == AS_BUILT else f"@{state}"
     tol, limit = _unit_tol(line.unit), spec.play_limit
     moves, touched = [], []
+    own = cuts is None  # cuts for this pose alone: dropped from the scene when it is done
     cuts = Cuts(scene.scene) if cuts is None else cuts
     for sign, past in zip((1.0, -1.0), history, strict=True):
         names = [spec.play_meshes[(n, sign)] for n in near]
@@ -209,6 +210,8 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
             who = next((i for i, (m, o) in enumerate(zip(ahead, facing, strict=True)) if scene.collide(m, o)), None)
         moves.append(move)
         touched.append(math.nan if who is None else float(spec.play_neighbours.index(near[who])))
+    if own:
+        cuts.clear()
     return moves[0], moves[1], touched[0], touched[1]
 
 
