@@ -74,6 +74,38 @@ def test_a_signal_in_the_first_instants_is_one_line(sig):
     assert any(code == 128 + sig for _, code, _ in outcomes)  # the signals did land
 
 
+# A signal landing inside a class body's __set_name__ during the command line's own start-up
+# imports (CI: SIGINT 0.01 s in, while pathlib imported ipaddress): Python hands the handler's
+# SystemExit on as "RuntimeError: Error calling __set_name__", which the start-up must not show.
+WRAPPED = r"""
+import os, signal, sys
+import gearcheck  # the package first, as the console script does
+
+class Finder:
+    def find_spec(self, name, path, target=None):
+        if name == "pathlib":
+            class Landing:
+                def __set_name__(self, owner, attr):
+                    os.kill(os.getpid(), signal.SIGINT)
+                    for _ in range(100000):  # the handler runs here, inside __set_name__
+                        pass
+            type("Network", (), {"broadcast_address": Landing()})
+        return None
+
+sys.modules.pop("pathlib", None)
+sys.meta_path.insert(0, Finder())
+import gearcheck.cli
+"""
+
+
+def test_a_signal_an_import_wraps_is_still_one_line():
+    done = subprocess.run([sys.executable, "-c", WRAPPED], cwd=ROOT, capture_output=True, text=True, timeout=60,
+                          check=False, env={**os.environ, "PYTHONPATH": str(ROOT / "src")})
+    assert "Traceback" not in done.stderr, done.stderr
+    assert done.returncode == 128 + signal.SIGINT, (done.returncode, done.stderr)
+    assert _messages(done.stderr) == ["gearcheck: interrupted (SIGINT): nothing written"], done.stderr
+
+
 def _check_until(args: list[str], stage: str, cwd: Path) -> tuple[subprocess.Popen, list[str]]:
     proc = subprocess.Popen([*GEARCHECK, "-v", *args], cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                             text=True)

@@ -62,9 +62,12 @@ try:  # after the handlers: an interrupt during start-up is one line too
     from pathlib import Path
     from typing import TYPE_CHECKING, Any
 
-except Interrupted as _early:
-    sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(_early.signum).name}): nothing written\n")
-    raise SystemExit(128 + _early.signum) from None
+except BaseException:
+    # the handler has written the line and raised SystemExit; an import may hand it on wrapped
+    # (a class body's __set_name__ turns it into a RuntimeError: ipaddress, under pathlib)
+    if not _received:
+        raise
+    raise SystemExit(128 + _received[0]) from None
 
 if TYPE_CHECKING:
     from gearcheck.design import Design
