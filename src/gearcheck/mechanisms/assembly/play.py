@@ -146,10 +146,11 @@ def contact_move(scene: CountedScene, spec: Spec, cuts: Cuts, x: float, sign: fl
     the whole pruned meshes, for the pose itself; ``keys``: the cut key per neighbour): the bracket
     the plain bisection of [0, limit] ends with, found around the first estimate that proves it —
     Newton steps on the gap between the cuts around the last contact (from the last poses' moves
-    extrapolated, :func:`_extrapolated`), the extrapolation alone, then with a wider margin, then
-    Newton steps on the whole directed meshes (the cuts seated again where they end) — else by the
-    plain bisection, to ``tol``. A collision between cuts answers "touching" (the cuts are
-    subsets); "free" is asked of the whole meshes."""
+    extrapolated, :func:`_extrapolated`); the same with every cut seated again by one whole
+    distance query; the extrapolation alone, then with a wider margin; :data:`COLD_STEPS` Newton
+    steps on the whole directed meshes continued between cuts seated where they end; all
+    :data:`NEWTON_STEPS` on the whole meshes — else by the plain bisection, to ``tol``. A collision
+    between cuts answers "touching" (the cuts are subsets); "free" is asked of the whole meshes."""
     part = spec.play
     assert part is not None
     kin, limit = spec.kin, spec.play_limit
