@@ -25,8 +25,8 @@ CERTIFIED_SHORT = "over the continuous motion"
 
 def _where(cert) -> str:
     """Where a roller certificate's least bound lies, in words."""
-    a0, a1 = (math.degrees(a) for a in cert.between_rad)
-    return f"roller {cert.link} between θ = {a0:.3f}° and {a1:.3f}°"
+    a0, a1 = (f"{math.degrees(a):.3f}" for a in cert.between_rad)
+    return f"roller {cert.link} at θ = {a0}°" if a0 == a1 else f"roller {cert.link} between θ = {a0}° and {a1}°"
 
 
 def chain_verdicts(outcome: SweepOutcome) -> list[Verdict]:
