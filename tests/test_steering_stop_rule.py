@@ -373,15 +373,17 @@ def test_the_stand_at_RS1_83_3_by_hand():
 # ----------------------------------------------------------------------------- the check
 
 @pytest.mark.cad
-@pytest.mark.parametrize("overrides, words", [
+@pytest.mark.parametrize("overrides, words, also", [
     (["pinion.topped_radius_mm=83.3", "trim.hS6_mm=26.2"],
      ["up to hS6 = 25.872 mm: S1 passes S2 at 72.556° and the rack stands at 105.482 mm until it is picked up "
-      "again at 72.881°, with S2 on G1's RS1 circle", "G1 cuts 0.1360 mm into the first rack tooth at +72.850°"]),
+      "again at 72.881°, with S2 on G1's RS1 circle", "G1 cuts 0.1360 mm into the first rack tooth at +72.850°"], set()),
+    # the rack stops for good: G1's tip land sweeps the top again on the way back (the mesh's overlap there,
+    # 0.019 mm, lies within its contact tolerance; the exact model certifies 0.0176 mm)
     (["trim.hS6_mm=26.15"],
      ["up to hS6 = 26.075 mm: S1 passes S2 at 76.011° and the rack stops there for good at 110.182 mm",
-      "G1 cuts 0.0684 mm into the first rack tooth at +77.550°"]),
+      "G1 cuts 0.0684 mm into the first rack tooth at +77.550°"], {"no_interference_reengage"}),
 ])
-def test_a_top_the_tip_land_catches_fails_the_check_not_the_input(tmp_path, capsys, overrides, words):
+def test_a_top_the_tip_land_catches_fails_the_check_not_the_input(tmp_path, capsys, overrides, words, also):
     """Both designs were refused as bad input (exit 2) before; they are designs that fail (exit 1):
     the interference verdicts fail, decided by the exact model, with the limit, where the rack stands
     and the overlap; every other design verdict passes."""
@@ -391,8 +393,9 @@ def test_a_top_the_tip_land_catches_fails_the_check_not_the_input(tmp_path, caps
     assert main(args) == 1
     s = json.loads((tmp_path / "run" / "summary.json").read_text())["steering"]
     failed = {name for name, ok in s["verdicts"].items() if not ok}
-    assert failed == {"no_interference_past_disengage", "no_interference_anywhere"}
+    assert failed == {"no_interference_past_disengage", "no_interference_anywhere"} | also
     assert all(s["verdict_evidence"][name].startswith("exact model") for name in failed)
+    assert s["certified"]["anywhere"]["certified_min_mm"] < -0.01  # the exact model over the continuous motion
     # where the mesh sweep found the pinion in the rack deeper than the contact tolerance, that pose is
     # confirmed on the exact solids: they overlap there, by a volume (RS1 83.3: the rack stands at
     # 105.482 mm while G1's tip land comes over the top; hS6 26.15: the meshed top drags the rack on)

@@ -24,6 +24,7 @@ from gearcheck.geometry.rack_pinion_contact import stop_phrase, whole_drive
 from gearcheck.geometry.rack_pinion_power import power_corner, power_model_travel
 from gearcheck.mechanism import Assembly, SweepPlan, Task
 from gearcheck.mechanisms.steering import analysis as an
+from gearcheck.mechanisms.steering import certified as ce
 from gearcheck.mechanisms.steering import handover as ho
 from gearcheck.mechanisms.steering import meshes as ms
 from gearcheck.mechanisms.steering.ends import EndTop, end_tops
@@ -117,6 +118,9 @@ class SteeringSweep:
     # how far the mesh's contact ends may lie from the exact model's (deg): the angle of one contact
     # tolerance of rack travel, r·Δφ = tol (the meshed rack lags the exact one by up to the chord sag)
     handover_tol_deg: float = math.nan
+    # scope ("anywhere", "return_swing", "past_disengage") → the exact model's clearance certified over
+    # the continuous motion (:func:`.certified.summary_entry`; + direction, the − one is its mirror)
+    certified: dict = field(default_factory=dict)
 
     def drive(self, mode: str, direction: int) -> ho.MeshDrive:
         return self.drives[(mode, direction)]
@@ -445,6 +449,10 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     rows, towing_dev, curves = _towing_rows(g, tow)
     power_rows, power_dev = _power_rows(g, power)
     rows += power_rows
+    t_cert = time.process_time()
+    exact = ce.certify_exact(g, tow[1]["angles_out"], curves[1]["out"], tow[1]["angles_back"], curves[1]["back"],
+                             power[1]["travels"], math.radians(model.disengage_deg))
+    certify_cpu_s = time.process_time() - t_cert
     drives = drives or {}
     plus, minus = (_direction_summary(tow[d], power[d], towing_dev[d], power_dev[d],
                                       towing_conjugate_end(g, tow[d], tol), drives[("towing", d)],
@@ -455,8 +463,14 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
              "fcl_queries_per_s": queries / elapsed, "task_seconds": [float(r["seconds"]) for r in results],
              "task_cpu_seconds": [float(r["cpu_seconds"]) for r in results]}
     speed["poses_per_cpu_s"] = len(rows) / sum(speed["task_cpu_seconds"])
+    speed["certify_cpu_s"] = certify_cpu_s
     speed["fcl_queries_per_cpu_s"] = queries / sum(speed["task_cpu_seconds"])
 
+    scopes = (("anywhere", ce.PARTS, ("min_signed_clearance_mm",)),
+              ("return_swing", ("back",), ("min_clearance_return_swing_mm",)),
+              ("past_disengage", ("past",), ("min_clearance_past_disengage_mm",)))
+    certified = {scope: ce.summary_entry(g, exact.scope(*parts), _least(plus[key], minus[key]))
+                 for scope, parts, (key,) in scopes if any(p in exact.parts for p in parts)}
     summary = {
         **_stated(plus, model.moving_at_end, tol),
         "model_disengage_angle_deg": model.disengage_deg,
@@ -481,6 +495,7 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "min_signed_clearance_mm": min(plus["min_signed_clearance_mm"], minus["min_signed_clearance_mm"]),
         "contact_tolerance_mm": tol,
         "mesh_error_bound_mm": bound,
+        "certified": {scope: {k: v for k, v in e.items() if k != "where"} for scope, e in certified.items()},
         "minus": _stated(minus, model.moving_at_end, tol),
         "poses": speed["poses"],
         "fcl_queries": speed["fcl_queries"],
@@ -501,6 +516,6 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     ]
     worst_poses += _deepest_overlap(kin, rows, tol)
     data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
-                         summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius))
+                         summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius), certified)
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}
     return SweepOutcome(summary, worst_poses, timings, data)

@@ -43,40 +43,76 @@ def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
              f"contact tolerance {tol:.3f} mm ≥ the meshes' error bound {data.bound:.3f} mm)")
     if not outcome.mesh_resolves:
         swept += "; the meshes do not resolve the design's clearance: the exact B-rep confirmation decides"
+    exact_ok, exact_words, exact_figures, exact_short = _exact(data, "return_swing")
+    ret_ok = _ok(ret, lambda c: c >= -tol)
     return [
         _continuous_drive(data, target),
         _contact_ratio(params, data.model.contact_ratio),
         _rack_stops(data, max_deg),
         _past_disengage(data, swept),
         Verdict.of("no_interference_reengage", "towing: no interference on the return swing and re-engagement",
-                   _ok(ret, lambda c: c >= -tol) and _ok(re, lambda x: True),
-                   f"min signed clearance {_num(min(ret), 5)} mm ≥ −{tol:.3f} mm; picked up at +{_num(re[0])}° / "
-                   f"−{_num(re[1])}° (free at {_num(bracket[0], 6)}°, touching at {_num(bracket[1], 6)}°)",
-                   _finite({"min_signed_clearance_mm": min(ret), "contact_tolerance_mm": tol,
-                            "plus_reengage_deg": re[0], "minus_reengage_deg": re[1]}),
-                   swept + "; the pick-up bracketed by bisection on the pinion angle",
-                   shortfall=_clearance_shortfall(ret, tol) if not _ok(ret, lambda c: c >= -tol) else
-                   "the return swing does not pick the rack up within the swing (no re-engage angle)"),
+                   ret_ok and exact_ok and _ok(re, lambda x: True),
+                   _and(f"min signed clearance {_num(min(ret), 5)} mm ≥ −{tol:.3f} mm; picked up at +{_num(re[0])}° / "
+                        f"−{_num(re[1])}° (free at {_num(bracket[0], 6)}°, touching at {_num(bracket[1], 6)}°)",
+                        exact_words),
+                   {**_finite({"min_signed_clearance_mm": min(ret), "contact_tolerance_mm": tol,
+                               "plus_reengage_deg": re[0], "minus_reengage_deg": re[1]}), **exact_figures},
+                   f"{EXACT_CERTIFIED}; {swept}; the pick-up bracketed by bisection on the pinion angle",
+                   shortfall="; ".join(filter(None, [_clearance_shortfall(ret, tol) if not ret_ok else "",
+                                                     exact_short]))
+                   or "the return swing does not pick the rack up within the swing (no re-engage angle)"),
         _anywhere(data, clear, poses, swept),
         _mesh_agrees(data),
     ]
 
 
+# The exact model's clearance between the poses (:mod:`.certified`).
+EXACT_CERTIFIED = ("exact model certified over the continuous motion (every tooth pair's clearance in closed form "
+                   "at the poses; between them bounded by the conjugate action, the stands and the driving contact, "
+                   "intervals split where that does not decide)")
+
+
+def _and(text: str, first: str) -> str:
+    """A verdict's words led by the certified bound, where there is one (it decides: the line the
+    command line prints starts with it)."""
+    return f"{first}; mesh sweep: {text}" if first else text
+
+
+def _exact(data: SteeringSweep, scope: str) -> tuple[bool, str, dict, str]:
+    """(passes, words, figures, shortfall) of the exact model certified over the continuous motion
+    for one claim's scope (all true and empty where the sweep has no such part)."""
+    e = data.certified.get(scope)
+    if e is None:
+        return True, "", {}, ""
+    least, req = e["certified_min_mm"], e["requirement_mm"]
+    ok = math.isfinite(least) and least >= req
+    words = (f"certified ≥ {_num(least, 5)} mm over the continuous motion (exact model: {e['where']}; "
+             f"{e['intervals']} intervals, {e['intervals_refined']} refined)")
+    figures = _finite({"exact_certified_min_mm": least, "exact_sampled_min_mm": e["sampled_min_mm"],
+                       "exact_requirement_mm": req})
+    short = "" if ok else (f"exact model: the clearance falls to {_num(least, 5)} mm ({e['where']}; "
+                           f"certified over the continuous motion), required ≥ {req:g} mm")
+    return ok, words, figures, short
+
+
 def _anywhere(data: SteeringSweep, clear: list[float], poses: int, swept: str) -> Verdict:
-    """Interference at any swept pose (mesh sweep), and a trimmed end tooth caught by its tip tooth
-    (exact model, :mod:`.ends`): either decides."""
+    """Interference at any swept pose (mesh sweep), over the continuous motion (exact model,
+    :mod:`.certified`), and a trimmed end tooth caught by its tip tooth (exact model, :mod:`.ends`):
+    any decides."""
     tol = data.tol
-    mesh_ok = _ok(clear, lambda c: c >= -tol)
+    exact_ok, exact_words, exact_figures, exact_short = _exact(data, "anywhere")
+    mesh_ok = _ok(clear, lambda c: c >= -tol) and exact_ok
     caught = [e for e in data.model.ends if not e.clears]
-    measured = f"min signed clearance {_num(min(clear), 5)} mm ≥ −{tol:.3f} mm over {poses} poses"
-    figures = _finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol})
-    shortfall = _clearance_shortfall(clear, tol) if not mesh_ok else ""
-    evidence = swept
+    measured = _and(f"min signed clearance {_num(min(clear), 5)} mm ≥ −{tol:.3f} mm over {poses} poses", exact_words)
+    figures = {**_finite({"min_signed_clearance_mm": min(clear), "contact_tolerance_mm": tol}), **exact_figures}
+    shortfall = "; ".join(filter(None, [_clearance_shortfall(clear, tol) if not _ok(clear, lambda c: c >= -tol)
+                                        else "", exact_short]))
+    evidence = f"{EXACT_CERTIFIED}; {swept}"
     if caught:
         measured += "; " + "; ".join(_end_measured(e) for e in caught)
         figures.update(_end_figures(data.model.ends))
         shortfall = "; ".join(filter(None, [shortfall, *(_end_shortfall(e) for e in caught)]))
-        evidence = f"{END_EVIDENCE}; {swept}"
+        evidence = f"{END_EVIDENCE}; {evidence}"
     return Verdict.of("no_interference_anywhere", "no interference at any pose (towing both ways, power mode)",
                       mesh_ok and not caught, measured, figures, evidence, shortfall=shortfall)
 
@@ -344,12 +380,14 @@ def _past_disengage(data: SteeringSweep, swept: str) -> Verdict:
                               shortfall="not checked: no disengage within the towing swing (see the rack_stops claim)")
     past = [plus["min_clearance_past_disengage_mm"], minus["min_clearance_past_disengage_mm"]]
     shifts = [plus["graze_contact_shift_mm"], minus["graze_contact_shift_mm"]]
+    exact_ok, exact_words, exact_figures, exact_short = _exact(data, "past_disengage")
+    past_ok = _ok(past, lambda c: c >= -tol)
     return Verdict.of(
         "no_interference_past_disengage", label,
-        _ok(past, lambda c: c >= -tol),
-        f"min signed clearance {_num(min(past), 5)} mm ≥ −{tol:.3f} mm; contact reached "
-        f"{_num(max(shifts), 5)} mm of rack shift away",
+        past_ok and exact_ok,
+        _and(f"min signed clearance {_num(min(past), 5)} mm ≥ −{tol:.3f} mm; contact reached "
+             f"{_num(max(shifts), 5)} mm of rack shift away", exact_words),
         {**_finite({"min_signed_clearance_mm": min(past), "contact_tolerance_mm": tol,
-                    "contact_shift_mm": max(shifts)}), **_end_figures(data.model.ends)},
-        swept + "; the closest pose past the stop confirmed on the exact B-rep",
-        shortfall=_clearance_shortfall(past, tol))
+                    "contact_shift_mm": max(shifts)}), **_end_figures(data.model.ends), **exact_figures},
+        f"{EXACT_CERTIFIED}; {swept}; the closest pose past the stop confirmed on the exact B-rep",
+        shortfall="; ".join(filter(None, [_clearance_shortfall(past, tol) if not past_ok else "", exact_short])))
