@@ -131,3 +131,26 @@ def test_the_worn_chain_is_certified_too(coarse):
     wear = next(v for v in result.verdicts if v.name == "chain_wear_within_limit")
     assert (wear.level == "pass") == (sleeve >= 0.0 and plate >= 0.0 and track["wear"]["declared_seats"] == 1)
     assert "certified over the continuous motion" in wear.measured
+
+
+# ----------------------------------------------------------------------------- the polygon effect
+
+@pytest.mark.parametrize("teeth, pitch_mm", [(49, 30.0), (20, 50.8), (31, 19.05)])
+def test_the_polygon_effect_on_the_wraps_poses_is_the_closed_form(teeth, pitch_mm):
+    """The entry run's speed ripple and chordal rise measured on the wrap's poses over a cycle equal
+    those of a z/2-sided polygon, 1 − cos(360°/z) and R·(1 − cos(360°/z)), to 1e-6 (every other
+    tooth engages: a link subtends two tooth steps)."""
+    wrap = tc.ChainWrap.centred(teeth, pitch_mm)
+    effect = tc.polygon_effect(wrap)
+    assert effect.ripple == pytest.approx(tc.speed_ripple(teeth), abs=1e-6)
+    assert effect.rise_mm == pytest.approx(tc.chordal_rise(pitch_mm, teeth), abs=1e-6)
+    # the speed peaks mid-cycle at ω·R (the seated pin at the run's tangent point) and is least at the
+    # seatings, where it is continuous across the cycle (the same on both sides)
+    assert effect.speed.max() == pytest.approx(1.0, abs=1e-9)
+    assert effect.speed[0] == pytest.approx(effect.speed[-1], abs=1e-9) == pytest.approx(effect.speed.min(), abs=1e-9)
+
+
+def test_the_check_reports_the_polygon_effect(coarse):
+    polygon = _track(coarse[1])["tca"]["polygon"]
+    assert polygon["speed_ripple_pct"] == pytest.approx(polygon["closed_form_speed_ripple_pct"], abs=1e-4)
+    assert polygon["chordal_rise_mm"] == pytest.approx(polygon["closed_form_chordal_rise_mm"], abs=1e-6)

@@ -275,3 +275,74 @@ def link_geometry(
         plate_start_x_mm=start_x,
         plate_end_x_mm=end_x,
     )
+
+
+# --------------------------------------------------------------------------------------------
+# The polygon effect: the entry run's speed and height over an engagement cycle
+
+@dataclass(frozen=True)
+class PolygonEffect:
+    """The entry run over one engagement cycle, from the wrap's poses: drive angles (rad), the run's
+    distance from the sprocket axis (mm) and its speed along itself over ω·R (R the pin circle's
+    radius); the speed ripple 1 − v_min/v_max and the chordal rise (the distance's range)."""
+
+    angles: np.ndarray
+    height_mm: np.ndarray
+    speed: np.ndarray
+
+    @property
+    def ripple(self) -> float:
+        return float(1.0 - self.speed.min() / self.speed.max())
+
+    @property
+    def rise_mm(self) -> float:
+        return float(self.height_mm.max() - self.height_mm.min())
+
+
+# Half the step of the central differences of the run's position (rad of drive angle): the error is
+# ~R·ε²/6 relative to R, far below 1e-9.
+SPEED_STEP_RAD = 1e-6
+
+
+def polygon_effect(wrap: ChainWrap, samples: int = 64) -> PolygonEffect:
+    """Measure the polygon effect on the wrap's own poses over one cycle, from one seating of an
+    entry pin to the next: the run through the entry-side seated pin (the line of the entry
+    direction), its distance from the axis, and the speed of the point one pitch up the run (its
+    position along the run, differentiated: central differences, one-sided at the two seatings,
+    where the run's speed has a kink)."""
+    beta = wrap.cycle_rad
+    lo = wrap.entry_angle_rad - beta / 2.0  # a pin seats on the entry side where its groove reaches this
+    start = float(np.min(np.mod(lo - wrap.groove_angles(0.0), beta)))
+    angles = start + beta * np.linspace(0.0, 1.0, samples + 1)
+    d_in = tangent_direction(wrap.entry_angle_rad)
+    normal = np.array([math.cos(wrap.entry_angle_rad), math.sin(wrap.entry_angle_rad)])
+    eps = SPEED_STEP_RAD
+    height, speed = np.empty(angles.size), np.empty(angles.size)
+    for n, theta in enumerate(angles):
+        last = int(np.flatnonzero(wrap.seated_pins(theta))[-1])  # the entry-side seated pin
+        height[n] = float(normal @ wrap.pin_positions(theta)[last])
+        # offsets on one side of a seating (the first and the last angle are seatings)
+        steps = (0.0, eps, 2 * eps) if n == 0 else (-2 * eps, -eps, 0.0) if n == samples else (-eps, 0.0, eps)
+        a, b, c = (float(d_in @ _run_point(wrap, theta + s, last)) for s in steps)
+        slope = (-3 * a + 4 * b - c) if n == 0 else (a - 4 * b + 3 * c) if n == samples else (c - a)
+        speed[n] = slope / (2 * eps) / wrap.pin_radius_mm
+    return PolygonEffect(angles, height, speed)
+
+
+def _run_point(wrap: ChainWrap, theta: float, pin: int) -> np.ndarray:
+    """The point one pitch up the entry run from the seated ``pin`` at drive angle θ (that pin on
+    the pin circle at its groove, as :meth:`ChainWrap.pin_positions` places it)."""
+    phi = float(wrap.groove_angles(theta)[pin])
+    r = wrap.pin_radius_mm
+    return np.array([r * math.cos(phi), r * math.sin(phi)]) - tangent_direction(wrap.entry_angle_rad) * wrap.pitch_mm
+
+
+def speed_ripple(teeth: int) -> float:
+    """Closed form of the run's speed ripple on every other tooth: 1 − cos(360°/z) (a link subtends
+    two tooth steps, so the chain is a polygon of z/2 sides)."""
+    return 1.0 - math.cos(2.0 * math.pi / teeth)
+
+
+def chordal_rise(pitch_mm: float, teeth: int) -> float:
+    """Closed form of the chordal rise on every other tooth: R·(1 − cos(360°/z)), R = d/2."""
+    return pin_circle_radius(pitch_mm, teeth) * speed_ripple(teeth)

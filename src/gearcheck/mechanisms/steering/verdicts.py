@@ -86,11 +86,11 @@ def _exact(data: SteeringSweep, scope: str) -> tuple[bool, str, dict, str]:
         return True, "", {}, ""
     least, req = e["certified_min_mm"], e["requirement_mm"]
     ok = math.isfinite(least) and least >= req
-    words = (f"certified ≥ {_num(least, 5)} mm over the continuous motion (exact model: {e['where']}; "
+    words = (f"certified ≥ {_num(least, 6)} mm over the continuous motion (exact model: {e['where']}; "
              f"{e['intervals']} intervals, {e['intervals_refined']} refined)")
     figures = _finite({"exact_certified_min_mm": least, "exact_sampled_min_mm": e["sampled_min_mm"],
                        "exact_requirement_mm": req})
-    short = "" if ok else (f"exact model: the clearance falls to {_num(least, 5)} mm ({e['where']}; "
+    short = "" if ok else (f"exact model: the clearance falls to {_num(least, 6)} mm ({e['where']}; "
                            f"certified over the continuous motion), required ≥ {req:g} mm")
     return ok, words, figures, short
 

@@ -8,6 +8,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from gearcheck.geometry import track_chain as tc
 from gearcheck.mechanisms.track.sweep import COLLIDE_SKIP_MM, TrackSweep, finite, rowmin
 from gearcheck.mechanisms.track.wear import MODE_TEXT
 from gearcheck.results import Comparison, Plot, Report, Series, SweepOutcome, Verdict
@@ -79,7 +80,21 @@ def _comparisons(d: TrackSweep) -> list[Comparison]:
                    finite(x["off_sleeve"].value), "approaching / leaving: falls steadily to ri − R as the pin seats",
                    exact=finite(x["ex_off_sleeve"].value)),
         *_wear_comparisons(d),
+        *_polygon_comparisons(d),
     ]
+
+
+def _polygon_comparisons(d: TrackSweep) -> list[Comparison]:
+    """The polygon effect on the entry run: the closed forms of a chain on every other tooth (a
+    polygon of z/2 sides) beside the figures measured on the wrap's own poses over a cycle."""
+    p, wrap = d.polygon, d.model.wrap
+    if p is None:
+        return []
+    note = "entry run over one engagement cycle, measured on the wrap's poses; model: z/2-sided polygon"
+    return [Comparison("chain speed ripple (polygon effect): 1 − cos(360°/z)", "%", None,
+                       100.0 * tc.speed_ripple(wrap.teeth), None, note, exact=100.0 * p.ripple),
+            Comparison("chordal rise of the run: R·(1 − cos(360°/z))", "mm", None,
+                       tc.chordal_rise(wrap.pitch_mm, wrap.teeth), None, note, exact=p.rise_mm)]
 
 
 def _wear_comparisons(d: TrackSweep) -> list[Comparison]:

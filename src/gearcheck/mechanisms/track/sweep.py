@@ -229,6 +229,7 @@ class TrackSweep:
     worn_mesh: WornMesh | None = None  # the mesh sweep of the chain at the declared worn pitch
     certified: TrackCertificates | None = None  # both figures over the continuous motion (:mod:`.certified`)
     worn_certified: TrackCertificates | None = None  # the same for the chain at the declared worn pitch
+    polygon: tc.PolygonEffect | None = None  # the entry run's speed and height over a cycle (the wrap's poses)
 
     @property
     def collisions(self) -> int:
@@ -424,7 +425,7 @@ def reduce_sweep(setup: _Setup, results: list) -> SweepOutcome:
                       len(setup.meshes[2].faces), exact.step_mm, exact.sagitta_mm, sweep_s, proof_s,
                       wear=track_wear.wear_limit(model.gap, model.link, wrap, model.wear_elongation, tables=tables),
                       worn_mesh=_worn_mesh(results[len(angles):], worn_table, exact.reach_mm), certified=certified,
-                      worn_certified=worn_certified)
+                      worn_certified=worn_certified, polygon=tc.polygon_effect(wrap))
     worst = [
         WorstPose(f"track: min tooth–sleeve clearance, {data.where(min_sleeve, sleeve=True)}", SPROCKET,
                   names[min_sleeve.link], s_sl.tolist(), pose_sl.tolist(), float(whole_link_at_sleeve)),
@@ -503,7 +504,16 @@ def summary(d: TrackSweep) -> dict:
                                    and x["ex_off_sleeve"].value >= x["ex_seated_sleeve"].value - WINDOW_ROUNDING_MM),
         **({} if d.wear is None else wear_summary(d.wear, d.worn_mesh, d.bound, d.worn_certified)),
         **({} if d.certified is None else {"certified": d.certified.summary()}),
+        **({} if d.polygon is None else {"tca": {"polygon": polygon_summary(d.polygon, wrap)}}),
     }
+
+
+def polygon_summary(p: tc.PolygonEffect, wrap: tc.ChainWrap) -> dict:
+    """The polygon effect measured on the wrap's poses beside its every-other-tooth closed forms."""
+    return {"speed_ripple_pct": 100.0 * p.ripple, "chordal_rise_mm": p.rise_mm,
+            "closed_form_speed_ripple_pct": 100.0 * tc.speed_ripple(wrap.teeth),
+            "closed_form_chordal_rise_mm": tc.chordal_rise(wrap.pitch_mm, wrap.teeth),
+            "cycle_deg": float(np.degrees(wrap.cycle_rad)), "samples_per_cycle": int(p.angles.size - 1)}
 
 
 def wear_summary(w: track_wear.WearLimit, worn: WornMesh | None = None, bound: float = 0.0,
