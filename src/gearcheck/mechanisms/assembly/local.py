@@ -70,10 +70,7 @@ class Cuts:
         """Cut ``mover`` and ``other`` (scene meshes) around the points ``local_a``, ``local_b`` (their
         own frames), replacing the key's earlier cut; ``grow``: twice as many faces as the key's
         cuts had (the contact strayed)."""
-        old = self.current.pop(key, None)
-        if old is not None:
-            self.scene.discard(old.mover)
-            self.scene.discard(old.other)
+        self._drop(key)
         faces = self.faces.get(key, CUT_FACES)
         if grow:
             faces = self.faces[key] = min(MOST_CUT_FACES, 2 * faces)
@@ -87,7 +84,12 @@ class Cuts:
 
     def clear(self) -> None:
         for key in list(self.current):
-            old = self.current.pop(key)
+            self._drop(key)
+
+    def _drop(self, key: tuple) -> None:
+        """The key's cut pair, if any, out of the scene."""
+        old = self.current.pop(key, None)
+        if old is not None:
             self.scene.discard(old.mover)
             self.scene.discard(old.other)
 
