@@ -167,3 +167,21 @@ def test_the_check_reports_the_te_as_designed_and_per_mounting_error(specs):
     a = tca["aligned"]
     assert a["least_play_arcmin"] == pytest.approx((a["coast_te_mean_urad"] - a["drive_te_mean_urad"]) * 1e-6
                                                    * 10800 / math.pi, abs=1e-4)
+
+
+@pytest.mark.cad
+def test_the_play_identity_holds_at_every_state_the_check_meshes(template_check):
+    """summary.json ``tca.states``: each thermal state's mounting as E/P/G/Σ and its TE from the check's
+    own exact solve, whose least TE_coast − TE_drive is the check's least play there (one model, to
+    1e-4′); warm, the mounting is the shim alone (G)."""
+    s = template_check("zhurong_differential").summary["differential"]
+    states = s["tca"]["states"]
+    assert {"warm", "cold"} <= set(states) <= set(s["states"])
+    for name, st in states.items():
+        assert st["least_play_arcmin"] == pytest.approx(s["states"][name]["exact_play_sampled_min_arcmin"],
+                                                        abs=1e-4), name
+    warm = states["warm"]
+    assert warm["big_axial_mm"] == pytest.approx(s["template_shim_mm"], abs=1e-9)
+    assert all(abs(warm[k]) < 1e-9 for k in ("offset_mm", "small_axial_mm", "shaft_angle_rad", "tilt_rad"))
+    cold = states["cold"]
+    assert cold["big_scale"] < 1.0 and cold["small_axial_mm"] < 0.0  # the cold gears shrink towards the apex

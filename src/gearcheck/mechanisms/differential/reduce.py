@@ -17,7 +17,7 @@ from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel_mesh import drive_poses
 from gearcheck.mechanisms.differential.analysis import PerSide, analyse_params, model_per_side
 from gearcheck.mechanisms.differential.params import shim_key
-from gearcheck.mechanisms.differential.tca import tca_summary
+from gearcheck.mechanisms.differential.tca import state_summary, tca_summary
 from gearcheck.mechanisms.differential.poses import GearSpecs
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup, normalised_poses, whole_name
 from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, merge_plays,
@@ -146,7 +146,11 @@ def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
     wall_s = time.perf_counter() - setup.started
     data = _arrays(setup, by_key, ranges)
     summary = _summary(setup, data, by_key)
-    summary["tca"] = tca_summary(setup.layout.specs)
+    t = data.t
+    summary["tca"] = {**tca_summary(setup.layout.specs),
+                      "states": {name: state_summary(setup.params, setup.layout.specs, data.template_shim_mm, temp,
+                                                     data.exact_plus[t, j], data.exact_minus[t, j])
+                                 for j, (name, temp) in enumerate(setup.states) if data.measured[t, j]}}
     worst = _worst_poses(setup, data, by_key)
     range_s = sum(results[task]["exact_s"] for _, task in setup.range_tasks)
     return SweepOutcome(summary, worst, _timings(setup, by_key, wall_s, range_s, onset_s), data)
