@@ -207,3 +207,27 @@ def test_a_coarse_check_certifies_the_same_verdicts(coarse, template_check):
         if v.name.startswith("no_interference"):
             assert "certified ≥" in v.measured and "over the continuous motion" in v.measured
             assert v.evidence.startswith("exact model certified over the continuous motion")
+
+
+def test_the_transmission_error_of_the_towing_swing_and_the_power_stroke(geometry):
+    """TE from the exact model's motion: zero over the continuous drive (every hand-over included),
+    leaving zero as the drive runs onto G1's tip corner (towing) or S6 (power mode), the rack lagging
+    when it stops; back at angle 0 the return swing has brought it back with no TE."""
+    from gearcheck.geometry.rack_pinion_contact import whole_drive
+    from gearcheck.mechanisms.steering.tca import tca_summary
+
+    g = geometry
+    tca = tca_summary(g, an.analyse_towing(g, 100.0))
+    towing, power = tca["towing"], tca["power"]
+    drive_towing, drive_power = (d.angle_deg for d in whole_drive(g))
+    assert towing["conjugate_te_pp_mm"] <= 1e-9 and abs(towing["conjugate_te_mean_mm"]) <= 1e-9
+    assert drive_towing < towing["te_departs_deg"] < drive_towing + 1.0
+    assert towing["te_at_disengage_mm"] < -0.5 and abs(towing["return_te_at_end_mm"]) <= 1e-9
+    assert 0.0 < towing["contact_height_min"] < 0.5 < towing["contact_height_max"] <= 1.0
+    assert drive_power < power["te_departs_deg"] < drive_power + 1.0 and power["te_at_stroke_end_mm"] < 0.0
+
+
+@pytest.mark.cad
+def test_the_check_reports_the_transmission_error(coarse):
+    outcome, _ = coarse
+    assert set(outcome.summary["tca"]) == {"towing", "power"}

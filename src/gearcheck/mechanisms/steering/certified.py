@@ -145,6 +145,13 @@ class _Stroke:
     detail for the pairs its path bound leaves within :data:`NEAR_MM`."""
 
     def __init__(self, tp: rc.ToothPairs, phis, travels, side: int, mode: str):
+        self._setup(tp, side, mode)
+        phis = np.asarray(phis, dtype=float)
+        travels = self.snapped(phis, np.asarray(travels, dtype=float))
+        sd, psi = self._clearances(phis, travels)
+        self.samples = [_Sample(float(phis[i]), float(travels[i]), sd[i], psi[i]) for i in range(phis.size)]
+
+    def _setup(self, tp: rc.ToothPairs, side: int, mode: str) -> None:
         g = tp.g
         self.g, self.side, self.mode = g, side, mode
         self.edge = 3 if side > 0 else 1  # the pushing flank among each rack tooth's edges
@@ -153,10 +160,6 @@ class _Stroke:
         self.conjugate_end = phi_power_conjugate_end(g, g.rack_first_tooth, g.hS6_mm)
         self.all = self._set(tp)
         self._sets: dict[tuple[int, ...], _Set] = {}
-        phis = np.asarray(phis, dtype=float)
-        travels = self.snapped(phis, np.asarray(travels, dtype=float))
-        sd, psi = self._clearances(phis, travels)
-        self.samples = [_Sample(float(phis[i]), float(travels[i]), sd[i], psi[i]) for i in range(phis.size)]
 
     def _set(self, tp: rc.ToothPairs) -> _Set:
         flank = tp.edges[:, self.edge]
@@ -383,6 +386,14 @@ class _Stroke:
         travel = push._travel_after(self.g, phi, a.travel, self.side, a.phi)
         travel = float(self.snapped(np.array([phi]), np.array([travel]))[0])
         return phi, min(max(travel, min(a.travel, b.travel)), max(a.travel, b.travel))
+
+
+def exact_travels(g: RackPinionGeometry, phis, travels, side: int) -> np.ndarray:
+    """The push model's towing travels pushed on to the exact teeth (:meth:`_Stroke.snapped`);
+    ``side`` +1 the forward swing (left flanks push), −1 the return swing."""
+    stroke = _Stroke.__new__(_Stroke)
+    stroke._setup(rc.ToothPairs(g, push.tooth_pairs(g)), side, "towing")
+    return stroke.snapped(np.asarray(phis, dtype=float), np.asarray(travels, dtype=float))
 
 
 def _power_travel(g: RackPinionGeometry, a: _Sample, b: _Sample, phi: float) -> float:

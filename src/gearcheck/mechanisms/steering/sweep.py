@@ -28,6 +28,7 @@ from gearcheck.mechanisms.steering import certified as ce
 from gearcheck.mechanisms.steering import handover as ho
 from gearcheck.mechanisms.steering import meshes as ms
 from gearcheck.mechanisms.steering.ends import EndTop, end_tops
+from gearcheck.mechanisms.steering.tca import tca_summary
 from gearcheck.mechanisms.steering.meshes import PINION, RACK
 from gearcheck.results import SweepOutcome, WorstPose
 
@@ -200,7 +201,7 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     def reduce(sent: list) -> SweepOutcome:
         results = [sent[0], sent[3], sent[1], sent[2]]
         drives = _mesh_drives(g, kin, flank_pairs, results)
-        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives)
+        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives, tca_summary(g, tow_model))
 
     return SweepPlan(meshes, tasks, reduce, weights, "pose", opts)
 
@@ -440,7 +441,8 @@ def _deepest_overlap(kin: Kinematics, rows: list[dict], tol: float) -> list[Wors
 
 
 def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results: list, tol: float, bound: float,
-            mesh_info: dict, t_start: float, paper: bool = True, drives: dict | None = None) -> SweepOutcome:
+            mesh_info: dict, t_start: float, paper: bool = True, drives: dict | None = None,
+            tca: dict | None = None) -> SweepOutcome:
     P = an.PAPER
     tow = {r["direction"]: r for r in results[:2]}
     power = {r["direction"]: r for r in results[2:]}
@@ -496,6 +498,7 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "contact_tolerance_mm": tol,
         "mesh_error_bound_mm": bound,
         "certified": {scope: {k: v for k, v in e.items() if k != "where"} for scope, e in certified.items()},
+        **({"tca": tca} if tca is not None else {}),
         "minus": _stated(minus, model.moving_at_end, tol),
         "poses": speed["poses"],
         "fcl_queries": speed["fcl_queries"],
