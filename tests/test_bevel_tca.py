@@ -77,9 +77,13 @@ class _Flanks:
     def at(self, u, v, tooth):
         return np.stack(bc.flank_xyz(self.spec, self.scale, tooth, 1, u, v), axis=-1)
 
-    def signed(self, q):
-        """Signed distance (+ outside the tooth, i.e. towards +azimuth of a side +1 flank) of points q
-        (gear frame) to the flank surface, and whether the foot lies inside the flank's parameters."""
+    def bounded(self, q):
+        """Distance of points q (gear frame) to the flank bounded by its edges (the foot clamped to
+        the flank's parameters), and whether the foot lies inside them."""
+        u, v, t, inside = self._foot(q)
+        return np.linalg.norm(q - self.at(u, v, t), axis=-1), inside
+
+    def _foot(self, q):
         _, i = self.tree.query(q)
         u, v, t = self.u[i].copy(), self.v[i].copy(), self.tooth[i]
         h = 1e-6
@@ -94,7 +98,13 @@ class _Flanks:
             u = u + (a22 * b1 - a12 * b2) / det
             v = v + (a11 * b2 - a12 * b1) / det
         inside = (u >= 0) & (u <= 1) & (v >= 0) & (v <= 1)
-        u, v = np.clip(u, 0, 1), np.clip(v, 0, 1)
+        return np.clip(u, 0, 1), np.clip(v, 0, 1), t, inside
+
+    def signed(self, q):
+        """Signed distance (+ outside the tooth, i.e. towards +azimuth of a side +1 flank) of points q
+        (gear frame) to the flank surface, and whether the foot lies inside the flank's parameters."""
+        u, v, t, inside = self._foot(q)
+        h = 1e-6
         s = self.at(u, v, t)
         su = self.at(u + h, v, t) - self.at(u - h, v, t)
         sv = self.at(u, v + h, t) - self.at(u, v - h, t)
@@ -185,3 +195,154 @@ def test_the_play_identity_holds_at_every_state_the_check_meshes(template_check)
     assert all(abs(warm[k]) < 1e-9 for k in ("offset_mm", "small_axial_mm", "shaft_angle_rad", "tilt_rad"))
     cold = states["cold"]
     assert cold["big_scale"] < 1.0 and cold["small_axial_mm"] < 0.0  # the cold gears shrink towards the apex
+
+
+# ------------------------------------------------------------------------- the contact pattern
+
+def test_the_pattern_gap_agrees_with_brute_force(specs):
+    """The pattern's gap at one drive angle (the big gear turned to its first contact there) agrees
+    with the brute force's nearest approach to the small gear's flank bounded by its edges (a point
+    cloud, then Newton steps on its parameters, the foot clamped to the flank) over the whole band
+    under 20 µm: to 1e-6 mm where the foot lies on the flank, to 2 % beyond its edges (there the
+    pattern takes the distance to the edge to first order)."""
+    big, small = specs.big, specs.small
+    m = bt.Misalignment(big_axial_mm=0.05)
+    mounting = bt.Mounting.of(m)
+    te = bt.mounted_transmission_error(big, small, mounting, cycles=1, per_cycle=4)
+    p = bt.contact_pattern(big, small, mounting, te, "drive", steps=1)  # at the first drive angle only
+    b, s = mounting.placed(big, small, te.drive_angles_rad[0], -te.drive_rad[0])
+    small_flanks = _Flanks(small)
+    brute = np.full(p.gap_mm.shape, np.inf)
+    t, u = np.meshgrid(p.height, p.along, indexing="ij")
+    for tooth in range(-2, 3):
+        pts = np.stack(bc.flank_xyz(big, 1.0, tooth, 1, t.ravel(), u.ravel()), axis=-1)
+        d, inside = small_flanks.bounded(_local(s.pose, _world(b.pose, pts)))
+        better = d.reshape(t.shape) < brute
+        brute = np.where(better, d.reshape(t.shape), brute)
+        on_flank = np.where(better, inside.reshape(t.shape), on_flank) if tooth > -2 else inside.reshape(t.shape)
+    near = p.gap_mm < 0.02
+    assert (near & on_flank).sum() > 50 and (near & ~on_flank).sum() > 10  # a band on the flank and beyond
+    np.testing.assert_allclose(p.gap_mm[near & on_flank], brute[near & on_flank], atol=1e-6)
+    np.testing.assert_allclose(p.gap_mm[near & ~on_flank], brute[near & ~on_flank], rtol=0.02, atol=1e-6)
+    assert p.gap_mm.min() < 1e-4  # touching at the contact
+
+
+def test_the_contact_path_lies_in_the_pattern(specs):
+    """Every first contact of the TE solve that the big gear's flank makes with its face or its
+    edges lies in the marked pattern (the nearest grid point's gap under the compound), on each
+    flank, aligned and misaligned. (Where an edge of the small gear bears on the big gear's face,
+    the mark is a stripe a few µm wide along that edge, narrower than the grid: the map's rings
+    show those contacts.) Misaligned by G the pattern leaves the toe and moves toward the heel;
+    aligned it bears from toe to heel."""
+    big, small = specs.big, specs.small
+    checked = 0
+    for m in (bt.Misalignment(), bt.Misalignment(big_axial_mm=0.05), bt.Misalignment(offset_mm=0.03)):
+        mounting = bt.Mounting.of(m)
+        te = bt.mounted_transmission_error(big, small, mounting, cycles=1, per_cycle=8)
+        bigs, smalls = zip(*(mounting.placed(big, small, phi) for phi in te.drive_angles_rad), strict=True)
+        both = bp.big_gear_contacts_both(bigs, smalls)
+        for flank, along, height, way in (("drive", te.drive_along, te.drive_height, both[0]),
+                                          ("coast", te.coast_along, te.coast_height, both[1])):
+            p = bt.contact_pattern(big, small, mounting, te, flank)
+            on_big = np.array([c.on == "big" for c in way])
+            i = np.abs(p.height[:, None] - height[None, :]).argmin(axis=0)
+            j = np.abs(p.along[:, None] - along[None, :]).argmin(axis=0)
+            assert np.all(p.gap_mm[i, j][on_big] <= p.compound_mm), (m, flank, p.gap_mm[i, j])
+            checked += int(on_big.sum())
+    assert checked >= 20  # of the 54 contacts
+    aligned = bt.Mounting.of()
+    e = bt.contact_pattern(big, small, aligned, bt.mounted_transmission_error(big, small, aligned, 1, 8)).extent()
+    assert e["toe"] and e["heel"] and e["along_max"] - e["along_min"] == 1.0
+    shifted = bt.Mounting.of(bt.Misalignment(big_axial_mm=0.1))
+    g = bt.contact_pattern(big, small, shifted, bt.mounted_transmission_error(big, small, shifted, 1, 8)).extent()
+    assert g["heel"] and not g["toe"] and g["centre_along"] > e["centre_along"] + 0.1
+
+
+def test_the_pattern_patch_lies_on_the_marked_flank(specs):
+    """The painted patch: every vertex stands just outside a big gear's drive flank (lifted across
+    the tooth by at most its lift, at least half of it), inside the tooth zone, on the teeth asked
+    for, and only where the pattern is marked."""
+    big, small = specs.big, specs.small
+    mounting = bt.Mounting.of(bt.Misalignment(big_axial_mm=0.1))
+    p = bt.contact_pattern(big, small, mounting, bt.mounted_transmission_error(big, small, mounting, 1, 8))
+    lift = 0.004
+    v, f = bt.pattern_patch(big, p, teeth=[0, 5], lift_mm=lift)
+    assert len(f) and f.max() < len(v)
+    x, y, z = (v[:, k].astype(float) for k in range(3))
+    tooth = np.round(np.arctan2(y, x) / big.angular_pitch_rad - 0.25)
+    assert set(tooth.tolist()) == {0.0, 5.0}
+    d = bc.signed_to_flank(big, x, y, z, tooth, 1.0)
+    assert np.all((d > 0.5 * lift) & (d <= lift + 1e-6)), (d.min(), d.max())
+    assert np.all(bc.in_tooth_zone(big, 1.0, x, y, z, tol=1e-4, along_tol=1e-3))
+    # only marked cells: the patch stays toward the heel, as the pattern does (toe clear under G)
+    along = (np.sqrt(x * x + y * y) * math.sin(big.pitch_angle_rad) + z * math.cos(big.pitch_angle_rad)
+             - big.inner_cone_distance_mm) / (big.outer_cone_distance_mm - big.inner_cone_distance_mm)
+    assert along.min() >= p.extent()["along_min"] - 1e-3
+
+
+@pytest.mark.cad
+def test_the_check_maps_the_pattern_warm_and_cold(template_check):
+    """summary.json ``tca.patterns``: warm (the shim's G alone) the pattern bears toward the heel
+    with the toe clear; cold it moves toward the toe and reaches it; on the involute throughout.
+    The template's requirement is a verdict, and the report maps the patterns and paints them."""
+    run = template_check("zhurong_differential")
+    s = run.summary["differential"]
+    patterns = s["tca"]["patterns"]
+    assert {"aligned", "warm", "cold"} <= set(patterns) and patterns["compound_um"] == 6.0
+    warm, cold = patterns["warm"]["drive"], patterns["cold"]["drive"]
+    assert warm["reaches_toe"] == 0.0 and warm["reaches_heel"] == 1.0
+    assert cold["reaches_toe"] == 1.0 and cold["centre_along"] < warm["centre_along"] - 0.1
+    assert all(p[f]["below_form"] == 0.0 for name, p in patterns.items() if name != "compound_um"
+               for f in ("drive", "coast"))
+    verdict = next(v for v in run.result.verdicts if v.name == "contact_pattern")
+    least = min(patterns[n][f]["length"] for n in ("warm", "cold", "operating_min", "operating_max")
+                for f in ("drive", "coast"))
+    assert verdict.figures["least_length"] == pytest.approx(least, abs=1e-12)
+    assert (verdict.level == "pass") == (least >= 0.5) and s["verdicts"]["contact_pattern"] == 1
+    page = (run.folder / "report.html").read_text(encoding="utf-8")
+    assert "Contact pattern, big gear drive flank, warm 25 °C" in page and "Transmission error of the coast" in page
+    assert 'class="gc3d-paint"' in page and '"overlays":[{' in page
+
+
+def test_the_mounting_study_samples_e_p_g_sigma_into_the_contact_analysis():
+    """The shipped study of the pairs' mounting errors: each variant's exact figures are the tooth
+    contact analysis of its own sampled E/P/G/Σ (the same function, run again on that variant),
+    the errors move them, and the zero-error design reproduces the check's pattern figures to the
+    study's coarser grid (1/28 of the face)."""
+    import gearcheck
+    from gearcheck.mechanisms.differential.poses import gear_specs
+    from gearcheck.mechanisms.differential.tca import STUDY_KEYS, study_figures
+
+    res = gearcheck.study("src/gearcheck/templates/studies/differential_mounting.toml", samples=6, exact=6, jobs=1,
+                          check_worst=0)
+    t = res.table.to_pydict()
+    fields = ("tca.offset_mm", "tca.small_axial_mm", "tca.big_axial_mm", "tca.shaft_angle_deg")
+    i = 2
+    one = gearcheck.load("templates/zhurong_differential.toml", {f: float(t[f"field.{f}"][i]) for f in fields})
+    again = study_figures(one.params, gear_specs(one.params))
+    assert {k: t[f"exact.{k}"][i] for k in STUDY_KEYS} == pytest.approx(again, abs=1e-9)
+    assert np.ptp(t["exact.te_pp_urad"]) > 1.0 and np.ptp(t["exact.pattern_length"]) > 0.02
+    design = gearcheck.load("templates/zhurong_differential.toml")
+    own = study_figures(design.params, gear_specs(design.params))
+    assert own["pattern_length"] == pytest.approx(0.554, abs=1 / 28)  # the check's least length (full grid)
+    assert set(res.summary["failures"]) == {"pattern_short", "pattern_at_tip", "pattern_on_one_end",
+                                            "te_over_300_urad"}
+
+
+def test_the_api_returns_the_curves_as_arrays():
+    """``Design.tca()``: the pair as designed and at each meshed state, as arrays — the same TE and
+    patterns the check reports (its figures come from this function)."""
+    import gearcheck
+    from gearcheck.mechanisms.differential.tca import pattern_summary
+
+    design = gearcheck.load("templates/zhurong_differential.toml")
+    got = design.tca()
+    assert list(got)[:3] == ["aligned", "warm", "cold"]
+    warm = got["warm"]
+    assert isinstance(warm.te.drive_rad, np.ndarray) and warm.te.drive_rad.shape == warm.te.drive_angles_rad.shape
+    assert warm.patterns["drive"].gap_mm.shape == (bt.PATTERN_PROFILE, bt.PATTERN_RULING)
+    assert np.ptp(got["aligned"].te.drive_rad) <= 1e-7 < np.ptp(warm.te.drive_rad)
+    e = pattern_summary(warm.patterns["drive"])
+    assert e["reaches_heel"] == 1.0 and e["reaches_toe"] == 0.0
+    with pytest.raises(ValueError, match="no tooth contact analysis"):
+        gearcheck.load("templates/assembly_spur_pair.toml").tca()

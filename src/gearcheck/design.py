@@ -131,6 +131,19 @@ class Design:
         with registry.calling(self.impl, "analyse"):
             return Calc(self.impl.section, self.impl.analyse(self.params))
 
+    def tca(self) -> Any:
+        """Tooth contact analysis (numpy only, no CAD): the curves behind summary.json ``tca`` as
+        arrays. The differential: {"aligned", "warm", "cold", ...} → its bevel pair's
+        :class:`gearcheck.mechanisms.differential.tca.PairTca` (``.te``: TE of each flank and the
+        contact path over two mesh cycles; ``.patterns["drive"|"coast"]``: the contact pattern
+        on the developed flank; ``.mounting``). The steering: the towing swing's and the power
+        stroke's TE against the pinion angle. The track and the roller chain: the polygon effect
+        over an engagement cycle. Raises ValueError for a mechanism without one."""
+        if type(self.impl).tca is registry.Mechanism.tca:
+            raise ValueError(f"{self.mechanism}: no tooth contact analysis")
+        with registry.calling(self.impl, "tca"):
+            return self.impl.tca(self.params)
+
     def build(self, out: str | Path | None = None, *, tol: float | None = None) -> BuildRun:
         """Build the CAD and write what ``gearcheck build`` writes into ``out`` (default out/NAME)."""
         from gearcheck import pipeline

@@ -172,6 +172,12 @@ class Mechanism(ABC):
         through ("towing swing angle, °"); none by default (numpy only)."""
         return [], ""
 
+    def tca(self, params: Any) -> Any:
+        """Tooth contact analysis (numpy only): how the mechanism's gears run — transmission error
+        and contact curves as arrays, in a mechanism's own objects. Optional: a mechanism without
+        one raises :class:`NotImplementedError`."""
+        raise NotImplementedError(f"{self.name}: no tooth contact analysis")
+
     # -- the CAD hook -------------------------------------------------------------------------
     @abstractmethod
     def parts(self, assembly: Assembly) -> list[Part]:

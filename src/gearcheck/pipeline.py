@@ -362,7 +362,7 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     summary["mesh_resolution"] = rule.summary()
     return CheckResult(impl.section, summary, verdicts, report.rows, report.comparisons, report.plots,
                        [*report.notes, rule.describe()], outcome.worst_poses, timings, mesh_plan.clearance,
-                       resolution=rule)
+                       resolution=rule, overlays=list(report.overlays))
 
 
 def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
@@ -483,7 +483,7 @@ def _geometry(design: Design, run: BuildRun, result: CheckResult, progress: Prog
 
     log.info("stage geometry: %s.glb, pictures, 3D view", design.name)
     with progress("drawing the geometry", 3, "step") as bar:
-        scene = replace(built, worst=worst_views(result))  # as views.scene_of with the result
+        scene = replace(built, worst=worst_views(result), overlays=list(result.overlays))  # as views.scene_of
         if drawing is not None:
             drawing.worst(scene)
         bar.update(1)

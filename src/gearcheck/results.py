@@ -142,6 +142,19 @@ class Series:
 
 
 @dataclass(frozen=True)
+class FieldMap:
+    """A scalar field a plot draws under its lines: ``values[i][j]`` at the point (``x[i][j]``,
+    ``y[i][j]``) of a structured grid, coloured from 0 (darkest) to ``vmax``; beyond ``vmax`` and
+    NaN are left blank. The axes keep x and y to one scale (a map)."""
+
+    x: list[list[float]]
+    y: list[list[float]]
+    values: list[list[float]]
+    label: str  # the colour bar's label, with its unit
+    vmax: float
+
+
+@dataclass(frozen=True)
 class Plot:
     title: str
     xlabel: str
@@ -151,6 +164,7 @@ class Plot:
     hlines: list[tuple[str, float]] = field(default_factory=list)  # horizontal lines: (label, y)
     ylim: tuple[float, float] | None = None  # a zoom on the values a verdict decides (None: all data)
     caption: str = ""  # what the plot shows and what to read from it, under the plot
+    field: FieldMap | None = None  # a map drawn under the series (x and y to one scale)
 
 
 @dataclass(frozen=True)
@@ -269,6 +283,8 @@ class Report:
     comparisons: list[Comparison] = field(default_factory=list)
     plots: list[Plot] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    # patches painted on parts in the 3D view (gearcheck.scene.Overlay: a contact pattern)
+    overlays: list[Any] = field(default_factory=list)
 
 
 @dataclass
@@ -291,6 +307,8 @@ class CheckResult:
     confirmations: list[Confirmation] = field(default_factory=list)
     # the mesh-resolution rule as checked on this run's meshes (gearcheck.resolution.Resolution)
     resolution: Any = None
+    # patches painted on parts in the 3D view (gearcheck.scene.Overlay), from the report
+    overlays: list[Any] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         names = [v.name for v in self.verdicts]

@@ -45,6 +45,19 @@ class DisplayPart:
 
 
 @dataclass(frozen=True)
+class Overlay:
+    """A painted patch on a part (a contact pattern on a gear's flanks): a mesh in the part's own
+    frame that moves with it in every view."""
+
+    name: str
+    host: str  # the part it is painted on
+    color: tuple[float, float, float]  # RGB 0…1
+    vertices: np.ndarray  # (n, 3) mm, the host's frame
+    faces: np.ndarray  # (m, 3)
+    label: str = ""  # what it shows, in words
+
+
+@dataclass(frozen=True)
 class PoseView:
     """A pose of the mechanism worth looking at: the parts it moves (others as built), their
     scales, and — for a worst pose — the two parts' closest points (world, mm) and distance."""
@@ -68,6 +81,7 @@ class Scene:
     worst: list[PoseView] = field(default_factory=list)
     frames: list[PoseView] = field(default_factory=list)
     frames_label: str = ""  # what the frames step through ("towing swing angle, °")
+    overlays: list[Overlay] = field(default_factory=list)  # painted on parts (contact patterns)
 
     def part(self, name: str) -> DisplayPart:
         return next(p for p in self.parts if p.name == name)

@@ -53,7 +53,8 @@ def scene_of(design: Any, assembly: Any, parts: list, result: CheckResult | None
 
     with calling(design.impl, "display_frames"):
         frames, label = design.impl.display_frames(design.params, assembly)
-    return Scene(design.name, shown, worst_views(result) if result is not None else [], list(frames), label)
+    return Scene(design.name, shown, worst_views(result) if result is not None else [], list(frames), label,
+                 list(result.overlays) if result is not None else [])
 
 
 @dataclass

@@ -156,7 +156,23 @@ def in_tooth_zone(spec: BevelGearSpec, scale, x, y, z, tol: float = 0.0, along_t
             & (along >= scale * f.inner - a_tol) & (along <= scale * f.outer + a_tol))
 
 
-def _facing_tooth(spec: BevelGearSpec, x, y, side) -> np.ndarray:
+def zone_excess(spec: BevelGearSpec, scale, x, y, z) -> np.ndarray:
+    """How far (mm) points (gear frame) lie outside the tooth zone of :func:`in_tooth_zone`: along
+    the face beyond the front or back cone, and across it beyond the tip or root cone (the arc at
+    the point's radius), combined as one distance (0 inside). With a point's distance d to a
+    flank's cone, √(d² + excess²) is its distance to the flank bounded by the zone, to first order:
+    a point beyond the flank's edge is that far from the edge."""
+    f = flank_constants(spec)
+    rho = np.sqrt(x * x + y * y)
+    r = np.sqrt(rho * rho + z * z)
+    theta = np.arctan2(rho, z)
+    along = rho * f.sin_pitch + z * f.cos_pitch
+    beyond_along = np.maximum(np.maximum(scale * f.inner - along, along - scale * f.outer), 0.0)
+    beyond_height = r * np.maximum(np.maximum(theta - f.face, f.root - theta), 0.0)
+    return np.sqrt(beyond_along * beyond_along + beyond_height * beyond_height)
+
+
+def facing_tooth(spec: BevelGearSpec, x, y, side) -> np.ndarray:
     """Index of the tooth whose flank ``side`` faces each point: the tooth space on side s of
     tooth k is centred at azimuth k·p + s·p/2."""
     pitch = spec.angular_pitch_rad
@@ -282,7 +298,7 @@ class _FlankSet:
         return out
 
     def _estimate(self, at: _Mover, q0: Xyz, way: np.ndarray, side: np.ndarray, other_scale) -> np.ndarray:
-        facing = _facing_tooth(self.other_spec, q0[0], q0[1], side)
+        facing = facing_tooth(self.other_spec, q0[0], q0[1], side)
         step = way * SECANT_FIRST_STEP_RAD
         d0 = signed_to_flank(self.other_spec, *q0, facing, side)
         d1 = signed_to_flank(self.other_spec, *at(step), facing, side)
@@ -318,7 +334,7 @@ class _FlankSet:
         q0 = at(0.0)
         shape = q0[0].shape
         side = np.broadcast_to(self.side, shape)
-        facing = _facing_tooth(self.other_spec, q0[0], q0[1], side)
+        facing = facing_tooth(self.other_spec, q0[0], q0[1], side)
 
         def dist(delta):
             return signed_to_flank(self.other_spec, *at(delta), facing, side)

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from gearcheck.geometry import bevel_contact as bc
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel import BevelGearSpec
 
@@ -103,6 +104,38 @@ class TransmissionError:
         return float(np.mean(self.drive_rad if flank == "drive" else self.coast_rad))
 
 
+@dataclass(frozen=True)
+class Mounting:
+    """A pair as mounted: each gear's rigid displacement (world 4×4, applied after its nominal
+    pose: the big gear's at turn 0, the small gear's of :func:`gearcheck.geometry.bevel_play.nominal_small_pose`)
+    and its scale about its apex."""
+
+    big_displacement: np.ndarray
+    small_displacement: np.ndarray
+    big_scale: float = 1.0
+    small_scale: float = 1.0
+
+    @classmethod
+    def of(cls, misalignment: Misalignment | None = None, big_scale: float = 1.0, small_scale: float = 1.0,
+           big_displacement: np.ndarray | None = None, small_displacement: np.ndarray | None = None) -> Mounting:
+        """Misaligned by ``misalignment``, then displaced by the given rigid displacements."""
+        db, ds = (misalignment or Misalignment()).displacements()
+        if big_displacement is not None:
+            db = np.asarray(big_displacement, float) @ db
+        if small_displacement is not None:
+            ds = np.asarray(small_displacement, float) @ ds
+        return cls(db, ds, big_scale, small_scale)
+
+    def placed(self, big: BevelGearSpec, small: BevelGearSpec, drive_angle_rad: float,
+               big_turn_rad: float = 0.0) -> tuple[bp.PlacedGear, bp.PlacedGear]:
+        """(big, small) with the small gear turned by its drive angle and the big gear by the
+        conjugate turn plus ``big_turn_rad``."""
+        turn = bp.conjugate_big_turn(big, small, drive_angle_rad) + big_turn_rad
+        return (bp.PlacedGear(big, self.big_displacement @ bp.rot_z4(turn), self.big_scale),
+                bp.PlacedGear(small, self.small_displacement @ bp.nominal_small_pose(big, small)
+                              @ bp.rot_z4(drive_angle_rad), self.small_scale))
+
+
 def transmission_error(big: BevelGearSpec, small: BevelGearSpec, misalignment: Misalignment | None = None,
                        cycles: float = 2.0, per_cycle: int = 24, big_scale: float = 1.0, small_scale: float = 1.0,
                        big_displacement: np.ndarray | None = None,
@@ -110,15 +143,15 @@ def transmission_error(big: BevelGearSpec, small: BevelGearSpec, misalignment: M
     """TE and contact path over ``cycles`` mesh cycles (a small-gear tooth pitch each) at
     ``per_cycle`` drive angles a cycle, the pair misaligned by ``misalignment`` (or displaced by
     the given rigid displacements, after it) and each gear scaled about its apex."""
-    db, ds = (misalignment or Misalignment()).displacements()
-    if big_displacement is not None:
-        db = np.asarray(big_displacement, float) @ db
-    if small_displacement is not None:
-        ds = np.asarray(small_displacement, float) @ ds
+    mounting = Mounting.of(misalignment, big_scale, small_scale, big_displacement, small_displacement)
+    return mounted_transmission_error(big, small, mounting, cycles, per_cycle)
+
+
+def mounted_transmission_error(big: BevelGearSpec, small: BevelGearSpec, mounting: Mounting, cycles: float = 2.0,
+                               per_cycle: int = 24) -> TransmissionError:
+    """:func:`transmission_error` of a pair as ``mounting`` places it."""
     angles = np.arange(int(round(cycles * per_cycle)) + 1) * small.angular_pitch_rad / per_cycle
-    nominal = bp.nominal_small_pose(big, small)
-    bigs = [bp.PlacedGear(big, db @ bp.rot_z4(bp.conjugate_big_turn(big, small, phi)), big_scale) for phi in angles]
-    smalls = [bp.PlacedGear(small, ds @ nominal @ bp.rot_z4(phi), small_scale) for phi in angles]
+    bigs, smalls = zip(*(mounting.placed(big, small, phi) for phi in angles), strict=True)
     plus, minus = bp.big_gear_contacts_both(bigs, smalls)
     spots = [np.array([on_big_tooth(b, c.angle_rad, c.point) for b, c in zip(bigs, way, strict=True)])
              for way in (plus, minus)]
@@ -135,3 +168,140 @@ def on_big_tooth(gear: bp.PlacedGear, turn_rad: float, point) -> tuple[float, fl
     cone = float(np.linalg.norm(local)) * math.cos(theta - s.pitch_angle_rad)
     return ((cone - s.inner_cone_distance_mm) / (s.outer_cone_distance_mm - s.inner_cone_distance_mm),
             (theta - s.root_angle_rad) / (s.face_angle_rad - s.root_angle_rad))
+
+
+# -- the contact pattern -------------------------------------------------------------------
+# Marking compound (mm): where the gap to the mating flank is under it, the flank takes the mark.
+COMPOUND_MM = 0.006
+# The developed flank's grid (profile root → tip, ruling toe → heel) and the drive angles a mesh
+# cycle the gap is taken at (the contact band moves a fraction of its width between them).
+PATTERN_PROFILE, PATTERN_RULING, PATTERN_STEPS = 81, 57, 48
+
+
+@dataclass(frozen=True)
+class ContactPattern:
+    """The unloaded contact pattern of one flank of the big gear's tooth: the least gap (mm) to
+    the mating flank over a whole pass of the tooth through the mesh, on a grid of its flank
+    parameters (``gap_mm[i, j]`` at height ``height[i]``, 0 root cone … 1 tip cone by polar
+    angle, and ``along[j]``, 0 toe … 1 heel); inf where the mating flank never lies over it. The
+    pattern is where the gap is under ``compound_mm``. ``developed`` maps the grid onto the flank
+    developed flat (mm along the face from the toe, mm up the profile from the root cone)."""
+
+    flank: str
+    height: np.ndarray
+    along: np.ndarray
+    gap_mm: np.ndarray
+    compound_mm: float
+    inner_mm: float  # cone distances of toe and heel (the big gear, unscaled)
+    outer_mm: float
+    root_rad: float  # polar angles of root and tip cone
+    face_rad: float
+    form: float  # the involute's start (height fraction): below it the flank is not involute
+
+    @property
+    def marked(self) -> np.ndarray:
+        return self.gap_mm <= self.compound_mm
+
+    def developed(self) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) mm of each grid point: x along the face from the toe, y up the profile (the
+        arc from the root cone at that cone distance)."""
+        cone = self.inner_mm + self.along * (self.outer_mm - self.inner_mm)
+        x = np.broadcast_to(cone - self.inner_mm, self.gap_mm.shape)
+        y = np.outer(self.height * (self.face_rad - self.root_rad), cone)
+        return x, y
+
+    def extent(self) -> dict[str, float]:
+        """Where the pattern lies: its span along the face and in height (fractions), its centre
+        (area-weighted on the developed flank), its share of the flank's area and whether it
+        reaches the toe, the heel, the tip or the root edge, or runs below the form line (off the
+        involute) (nan and False: no pattern)."""
+        m = self.marked
+        if not m.any():
+            nan = float("nan")
+            return {"along_min": nan, "along_max": nan, "height_min": nan, "height_max": nan, "centre_along": nan,
+                    "centre_height": nan, "area_share": 0.0, "toe": False, "heel": False, "tip": False,
+                    "root": False, "below_form": False}
+        rows, cols = np.nonzero(m)
+        weight = np.broadcast_to((self.inner_mm + self.along * (self.outer_mm - self.inner_mm))[None, :], m.shape)
+        w = weight * m
+        return {"along_min": float(self.along[cols.min()]), "along_max": float(self.along[cols.max()]),
+                "height_min": float(self.height[rows.min()]), "height_max": float(self.height[rows.max()]),
+                "centre_along": float((w * self.along[None, :]).sum() / w.sum()),
+                "centre_height": float((w * self.height[:, None]).sum() / w.sum()),
+                "area_share": float(w.sum() / weight.sum()),
+                "toe": bool(m[:, 0].any()), "heel": bool(m[:, -1].any()), "tip": bool(m[-1].any()),
+                "root": bool(m[0].any()), "below_form": bool(m[self.height < self.form - 1e-12].any())}
+
+
+def contact_pattern(big: BevelGearSpec, small: BevelGearSpec, mounting: Mounting, te: TransmissionError,
+                    flank: str = "drive", compound_mm: float = COMPOUND_MM, steps: int = PATTERN_STEPS,
+                    profile: int = PATTERN_PROFILE, ruling: int = PATTERN_RULING) -> ContactPattern:
+    """The contact pattern of the big gear's ``flank`` (drive: side +1, closed by the big gear's
+    + turn; coast: side −1) with the pair mounted as ``mounting`` and turned to contact by
+    ``te`` (its TE over at least one mesh cycle, interpolated between its drive angles): at
+    ``steps`` drive angles over one cycle, the gap from each grid point of the big gear's flank
+    (every tooth near the mesh) to the small gear's flank of the same side, bounded by its tooth
+    zone (beyond the flank's edge, the distance to the edge: an edge of the small gear bearing on
+    the big gear's face marks it too; :func:`gearcheck.geometry.bevel_contact.zone_excess`); the
+    least over the angles and teeth (one cycle of every tooth is one whole pass of a tooth: the
+    teeth are identical)."""
+    side = 1.0 if flank == "drive" else -1.0
+    curve = te.drive_rad if flank == "drive" else te.coast_rad
+    pitch = small.angular_pitch_rad
+    if te.drive_angles_rad[-1] - te.drive_angles_rad[0] < pitch * (1.0 - 1e-9):
+        raise ValueError("the TE must cover a whole mesh cycle")
+    f = bc.flank_constants(big)
+    t = np.linspace(0.0, 1.0, profile)
+    u = np.linspace(0.0, 1.0, ruling)
+    window = bp.teeth_window(big, small) + 1
+    teeth = np.arange(-window, window + 1)
+    gap = np.full((profile, ruling), np.inf)
+    for phi in te.drive_angles_rad[0] + np.arange(steps) * pitch / steps:
+        turn = -float(np.interp(phi, te.drive_angles_rad, curve))  # the big gear's contact turn
+        b, s = mounting.placed(big, small, phi, turn)
+        rel = bc.rigid_inverse(s.pose) @ b.pose  # big frame → small frame
+        centre = round(math.atan2(rel[2, 1], rel[2, 0]) / f.pitch)  # the big tooth facing the small gear
+        x, y, z = bc.flank_xyz(big, b.scale, (centre + teeth)[:, None, None], side, t[None, :, None],
+                               u[None, None, :])
+        px = rel[0, 0] * x + rel[0, 1] * y + rel[0, 2] * z + rel[0, 3]
+        py = rel[1, 0] * x + rel[1, 1] * y + rel[1, 2] * z + rel[1, 3]
+        pz = rel[2, 0] * x + rel[2, 1] * y + rel[2, 2] * z + rel[2, 3]
+        facing = bc.facing_tooth(small, px, py, side)
+        d = bc.signed_to_flank(small, px, py, pz, facing, side)
+        e = bc.zone_excess(small, s.scale, px, py, pz)  # beyond the small gear's flank: to its edge
+        gap = np.minimum(gap, np.sqrt(d * d + e * e).min(axis=0))
+    return ContactPattern(flank, t, u, gap, compound_mm, big.inner_cone_distance_mm, big.outer_cone_distance_mm,
+                          big.root_angle_rad, big.face_angle_rad,
+                          (big.form_angle_rad - big.root_angle_rad) / (big.face_angle_rad - big.root_angle_rad))
+
+
+def pattern_patch(spec: BevelGearSpec, pattern: ContactPattern, teeth=None, every: int = 4,
+                  lift_mm: float = 0.004) -> tuple[np.ndarray, np.ndarray]:
+    """The pattern as a triangle mesh on the flanks of ``teeth`` (default every tooth) in the
+    gear's own frame, for painting on the gear in a 3D view: the grid cells (every ``every``-th
+    grid line) whose corners are all marked, lifted ``lift_mm`` off the flank (outward, across the
+    tooth) so that it shows over the gear's own mesh. Returns (vertices (n, 3) float32, faces
+    (m, 3) uint32)."""
+    side = 1.0 if pattern.flank == "drive" else -1.0
+    t, u = pattern.height[::every], pattern.along[::every]
+    marked = pattern.marked[::every, ::every]
+    cells = marked[:-1, :-1] & marked[1:, :-1] & marked[:-1, 1:] & marked[1:, 1:]
+    i, j = np.nonzero(cells)
+    if i.size == 0:
+        return np.zeros((0, 3), np.float32), np.zeros((0, 3), np.uint32)
+    used = np.zeros(marked.shape, bool)
+    for di in (0, 1):
+        for dj in (0, 1):
+            used[i + di, j + dj] = True
+    number = np.cumsum(used.ravel()).reshape(used.shape) - 1
+    rows, cols = np.nonzero(used)
+    a, b, c, d = number[i, j], number[i + 1, j], number[i + 1, j + 1], number[i, j + 1]
+    quads = np.concatenate([np.stack([a, b, c], axis=1), np.stack([a, c, d], axis=1)])
+    teeth = np.arange(spec.teeth) if teeth is None else np.asarray(teeth)
+    verts, faces = [], []
+    for k, tooth in enumerate(teeth):
+        x, y, z = bc.flank_xyz(spec, 1.0, tooth, side, t[rows], u[cols])
+        az = np.arctan2(y, x)
+        verts.append(np.stack([x - side * lift_mm * np.sin(az), y + side * lift_mm * np.cos(az), z], axis=1))
+        faces.append(quads + k * len(rows))
+    return np.concatenate(verts).astype(np.float32), np.concatenate(faces).astype(np.uint32)

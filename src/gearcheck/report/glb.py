@@ -237,13 +237,20 @@ def glb_bytes(scene: Scene) -> bytes:
             meshes[key] = w.mesh(p.name, p.vertices, p.faces, material)
         part_mesh[p.name] = meshes[key]
 
+    painted: dict[str, list[int]] = {}  # the overlays' nodes by host (children of its as-built node)
+    for o in scene.overlays:
+        mesh = w.mesh(o.name, np.asarray(o.vertices, np.float32), np.asarray(o.faces, np.uint32),
+                      w.material(o.name, o.color, 0.0))
+        painted.setdefault(o.host, []).append(w.node(o.name, mesh, None, {"label": o.label} if o.label else None))
+
     def part_nodes(prefix: str, view: PoseView | None) -> list[int]:
         out = []
         for p in scene.parts:
             pose = p.pose if view is None else np.asarray(view.poses.get(p.name, p.pose), float)
             scale = 1.0 if view is None else float(view.scales.get(p.name, 1.0))
             extras = {"material": p.material} if view is None else None
-            out.append(w.node(prefix + p.name, part_mesh[p.name], _scaled(pose, scale), extras))
+            children = painted.get(p.name) if view is None else None
+            out.append(w.node(prefix + p.name, part_mesh[p.name], _scaled(pose, scale), extras, children))
         return out
 
     def rooted(name: str, children: list[int]) -> list[int]:

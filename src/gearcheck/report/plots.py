@@ -21,7 +21,7 @@ import textwrap
 from typing import Any
 
 from gearcheck.report.child import ChildOwner
-from gearcheck.results import Plot
+from gearcheck.results import FieldMap, Plot
 
 # Series colours (matplotlib's tab10, in order) and reference-line colours.
 COLOURS = ["#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b", "#e377c2", "#7f7f7f", "#bcbd22",
@@ -131,6 +131,22 @@ def _draw_series(ax, plot: Plot) -> list[tuple[str, str]]:
     return key
 
 
+def _draw_field(fig, ax, field: FieldMap) -> None:
+    """The map under the series: cells coloured by value (darkest at 0, blank beyond ``vmax``),
+    rasterised inside the SVG (a fine grid as vector cells would weigh megabytes), with a colour
+    bar; x and y to one scale."""
+    import numpy as np
+
+    values = np.asarray(field.values, float)
+    shown = np.ma.masked_where(~np.isfinite(values) | (values > field.vmax), values)
+    mesh = ax.pcolormesh(np.asarray(field.x, float), np.asarray(field.y, float), shown, cmap="YlOrRd_r",
+                         vmin=0.0, vmax=field.vmax * 1.25, shading="gouraud", rasterized=True, zorder=0)
+    bar = fig.colorbar(mesh, ax=ax, shrink=0.85, pad=0.02)
+    bar.set_label(field.label)
+    bar.ax.set_ylim(0.0, field.vmax)
+    ax.set_aspect("equal", adjustable="datalim")
+
+
 def _draw_hlines(ax, plot: Plot, yunit: str) -> list[tuple[str, str]]:
     key = []
     for i, (label, y) in enumerate(_hlines(plot)):
@@ -212,6 +228,8 @@ def plot_html(plot: Plot, *, key: bool = True) -> str:
     plt = _plt()
     with plt.rc_context(RC):
         fig, ax = plt.subplots(figsize=FIGSIZE, dpi=100)
+        if plot.field is not None:
+            _draw_field(fig, ax, plot.field)
         entries = _draw_series(ax, plot)
         entries += _draw_hlines(ax, plot, axis_unit(plot.ylabel))
         if plot.ylim is not None:

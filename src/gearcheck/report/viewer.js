@@ -103,6 +103,20 @@ function start() {
       box: geometries[p.m].boundingBox};
   });
   const byName = new Map(parts.map((p) => [p.name, p]));
+  // patches painted on parts (contact patterns): children of their part, so they move with it
+  for (const o of data.overlays || []) {
+    const host = byName.get(o.h);
+    if (!host) continue;
+    const g = new THREE.BufferGeometry();
+    g.setAttribute("position", new THREE.BufferAttribute(new Float32Array(bytes(o.v)), 3));
+    g.setIndex(new THREE.BufferAttribute(o.u16 ? new Uint16Array(bytes(o.i)) : new Uint32Array(bytes(o.i)), 1));
+    g.computeVertexNormals();
+    const paint = new THREE.Mesh(g, new THREE.MeshStandardMaterial({
+      color: new THREE.Color().setRGB(o.c[0], o.c[1], o.c[2], THREE.SRGBColorSpace), metalness: 0,
+      roughness: 0.6, side: THREE.DoubleSide}));
+    paint.name = o.n;
+    host.mesh.add(paint);
+  }
 
   // closest-point markers: round dots of a fixed size on screen, drawn over everything
   const dot = document.createElement("canvas");

@@ -52,6 +52,8 @@ CSS = """
 .gc3d-frames { display: flex; flex-wrap: wrap; gap: 0.3em 0.8em; align-items: center; margin-top: 0.4em; }
 .gc3d-frames label { display: flex; gap: 0.5em; align-items: center; flex: 1 1 12em; min-width: 0; }
 .gc3d-frames input { flex: 1 1 auto; min-width: 0; }
+.gc3d-paint { font-size: 0.9em; margin: 0.4em 0 0; }
+.gc3d-sw { display: inline-block; width: 0.9em; height: 0.9em; vertical-align: -0.1em; border-radius: 2px; }
 .gc3d-status { font-size: 0.9em; margin: 0.4em 0 0; min-height: 1.4em; overflow-wrap: anywhere; }
 .gc3d figcaption { font-size: 0.85em; color: #5a6275; margin-top: 0.3em; }
 .gc3d-fallback { border: 1px dashed #b0b6c3; padding: 0.5em 0.8em; overflow-wrap: anywhere; }
@@ -133,8 +135,12 @@ def scene_data(scene: Scene) -> dict:
             if cut is not None:
                 entry["cut"] = [round(float(x), 7) + 0.0 for x in np.concatenate(cut)]
         worst.append(entry)
+    overlays = [{"n": o.name, "h": o.host, "c": [round(float(c), 4) for c in o.color],
+                 "v": _b64(np.asarray(o.vertices, "<f4")),
+                 "i": _b64(np.asarray(o.faces, "<u2" if len(o.vertices) < 65536 else "<u4")),
+                 "u16": len(o.vertices) < 65536} for o in scene.overlays]
     return {"name": scene.name, "meshes": meshes, "parts": parts, "worst": worst,
-            "frames": [_view(f) for f in scene.frames], "frames_label": scene.frames_label}
+            "frames": [_view(f) for f in scene.frames], "frames_label": scene.frames_label, "overlays": overlays}
 
 
 def _fallback(scene: Scene) -> str:
@@ -175,6 +181,18 @@ def _frames(scene: Scene) -> str:
             f'aria-label="motion frame"></label><output aria-live="polite">{first}</output></div>')
 
 
+def _painted(scene: Scene) -> str:
+    """What is painted on the parts, each with its colour (under the view)."""
+    if not scene.overlays:
+        return ""
+    items = []
+    for o in scene.overlays:
+        rgb = "#" + "".join(f"{round(255 * c):02x}" for c in o.color)
+        items.append(f"<span><span class='gc3d-sw' style='background:{rgb}'></span> {html.escape(o.label)} on "
+                     f"{html.escape(o.host)}</span>")
+    return f'<p class="gc3d-paint">Painted: {"; ".join(items)}</p>'
+
+
 def viewer_html(scene: Scene) -> str:
     """The 3D view as one HTML block (a ``<figure class="gc3d">``) to inline in report.html."""
     payload = json.dumps(scene_data(scene), separators=(",", ":"), allow_nan=False)
@@ -194,7 +212,7 @@ def viewer_html(scene: Scene) -> str:
         f"</label></div>"
         f'<div class="gc3d-stage"><canvas tabindex="0" role="img" aria-label="3D view of {title}: drag to turn">'
         f'</canvas><div class="gc3d-tag" hidden></div></div>'
-        f"{frames_bar}"
+        f"{frames_bar}{_painted(scene)}"
         f'<p class="gc3d-status" aria-live="polite"></p>'
         f'<div class="gc3d-fallback" hidden>{_fallback(scene)}</div>'
         f'<noscript><div class="gc3d-fallback">{_fallback(scene)}</div></noscript>'

@@ -66,6 +66,11 @@ class Differential(Mechanism):
             return None
         return clearance(specs, params.shim.thickness_mm, plays, dict(meshed_states(params)))
 
+    def tca(self, params: DifferentialParams) -> dict[str, Any]:
+        from gearcheck.mechanisms.differential.tca import design_tca
+
+        return design_tca(params)
+
     def study_row(self, params: DifferentialParams, level: str) -> dict[str, float]:
         from gearcheck.mechanisms.differential import study
 

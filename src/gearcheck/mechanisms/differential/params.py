@@ -40,6 +40,12 @@ def apex_a_mm(geom: analysis.ConeGeometry, l2_mm: float) -> float:
     return 2.0 * (l2_mm + geom.big_pitch_diameter_mm / 2.0)
 
 
+# Mounting errors the tooth contact analysis takes (far beyond any assembly tolerance; the contact
+# solve needs the gears in mesh).
+MOUNTING_ERROR_MAX_MM = 0.5
+MOUNTING_ERROR_MAX_DEG = 0.5
+
+
 def _unit(unit: str) -> dict:
     return {"unit": unit}
 
@@ -290,6 +296,43 @@ class Targets(Section):
                         description="why the level is what it is (shown with the verdict)")
 
 
+class Tca(Section):
+    """Tooth contact analysis of each big/small pair (the report's TE and contact pattern): the
+    marking compound, the pair's mounting errors beyond the design (E/P/G/Σ, taken on top of each
+    thermal state's own displacements; the play checks take the housing as designed, and what
+    the errors cost in play shows as the least TE_coast − TE_drive of ``tca.mounted``), and a
+    requirement on the pattern (optional; given, it is a verdict): it must bear over at least
+    ``pattern_min_length`` of the face width on both flanks at every running state (warm, cold
+    design point, operating minimum and maximum) and stay on the involute."""
+
+    compound_um: float = Field(
+        default=6.0, gt=0.0, le=100.0,
+        description="marking compound thickness: the flank takes the mark where the gap to the mating flank is "
+                    "under it", json_schema_extra=_unit("µm"))
+    offset_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
+                             description="E: offset of the small gear's axis from the big gear's, along their common "
+                                         "perpendicular", json_schema_extra=_unit("mm"))
+    small_axial_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
+                                  description="P: the small gear moved along its axis, away from the apex (+ opens "
+                                              "the mesh)", json_schema_extra=_unit("mm"))
+    big_axial_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
+                                description="G: the big gear moved along its axis, away from the apex (+ opens the "
+                                            "mesh), beyond the shim", json_schema_extra=_unit("mm"))
+    shaft_angle_deg: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_DEG, le=MOUNTING_ERROR_MAX_DEG,
+                                   description="Σ: the shaft angle's error (+ opens it beyond 90°)",
+                                   json_schema_extra=_unit("°"))
+    pattern_min_length: float | None = Field(
+        default=None, gt=0.0, le=1.0,
+        description="least share of the face width (toe to heel) the pattern must cover at each running state")
+    level: Literal["fail", "warn"] = Field(
+        default="fail", description="what a pattern short of it is: a failed design (default) or a warning")
+
+    @property
+    def mounting_errors(self) -> tuple[float, float, float, float]:
+        """(E mm, P mm, G mm, Σ rad)."""
+        return self.offset_mm, self.small_axial_mm, self.big_axial_mm, math.radians(self.shaft_angle_deg)
+
+
 class Params(Section):
     """The whole template (less its top-level ``mechanism`` key)."""
 
@@ -301,6 +344,7 @@ class Params(Section):
     shim: Shim
     calibration: Calibration = Field(default_factory=Calibration)
     targets: Targets = Field(default_factory=Targets)
+    tca: Tca = Field(default_factory=Tca)
     # the thinning solved from [calibration] by the validation (None: the template's [backlash])
     _thinning: cal.Thinning | None = PrivateAttr(default=None)
 

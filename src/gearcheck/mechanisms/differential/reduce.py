@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -17,7 +17,8 @@ from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel_mesh import drive_poses
 from gearcheck.mechanisms.differential.analysis import PerSide, analyse_params, model_per_side
 from gearcheck.mechanisms.differential.params import shim_key
-from gearcheck.mechanisms.differential.tca import state_summary, tca_summary
+from gearcheck.mechanisms.differential.tca import (PairTca, design_tca, mounted_summary, patterns_summary,
+                                                   sensitivity, state_summary, tca_summary)
 from gearcheck.mechanisms.differential.poses import GearSpecs
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS, SweepSetup, normalised_poses, whole_name
 from gearcheck.mechanisms.differential.temperature import (GRID_STEP_K, STATE_TEXT, RangeCheck, merge_plays,
@@ -70,6 +71,9 @@ class SweepData:
     # per (shim, state) measured: the exact least play over the continuous cycle, refined between
     # the swept angles (:func:`_refined`)
     refined: dict[tuple[int, int], Refined] = field(default_factory=dict)
+    # tooth contact analysis: the pair as designed ("aligned"), then each state meshed at the
+    # template's shim (:class:`gearcheck.mechanisms.differential.tca.PairTca`)
+    tca: list[PairTca] = field(default_factory=list)
 
     @property
     def w(self) -> int:
@@ -146,11 +150,17 @@ def reduce_sweep(setup: SweepSetup, results: list[dict]) -> SweepOutcome:
     wall_s = time.perf_counter() - setup.started
     data = _arrays(setup, by_key, ranges)
     summary = _summary(setup, data, by_key)
-    t = data.t
-    summary["tca"] = {**tca_summary(setup.layout.specs),
-                      "states": {name: state_summary(setup.params, setup.layout.specs, data.template_shim_mm, temp,
+    t, specs = data.t, setup.layout.specs
+    measured = [(j, name, temp) for j, (name, temp) in enumerate(setup.states) if data.measured[t, j]]
+    pairs = list(design_tca(setup.params).values())  # as designed, then each meshed state
+    data = replace(data, tca=pairs)
+    summary["tca"] = {**tca_summary(specs),
+                      "states": {name: state_summary(setup.params, specs, data.template_shim_mm, temp,
                                                      data.exact_plus[t, j], data.exact_minus[t, j])
-                                 for j, (name, temp) in enumerate(setup.states) if data.measured[t, j]}}
+                                 for j, name, temp in measured},
+                      "patterns": {"compound_um": setup.params.tca.compound_um, **patterns_summary(pairs)},
+                      "mounted": mounted_summary(pairs),
+                      "sensitivity": {p.name: sensitivity(specs, p) for p in pairs if p.name in ("warm", "cold")}}
     worst = _worst_poses(setup, data, by_key)
     range_s = sum(results[task]["exact_s"] for _, task in setup.range_tasks)
     return SweepOutcome(summary, worst, _timings(setup, by_key, wall_s, range_s, onset_s), data)

@@ -13,6 +13,7 @@ import numpy as np
 from gearcheck.mechanisms.differential import PAPER, paper_conditions
 from gearcheck.mechanisms.differential.reduce import SweepData
 from gearcheck.mechanisms.differential.sweep import DIRECTIONS
+from gearcheck.mechanisms.differential.tca_report import tca_overlays, tca_plots
 from gearcheck.mechanisms.differential.temperature import STATE_TEXT, RangeCheck, shim_text
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS
 from gearcheck.results import Comparison, Plot, Report, Series, SweepOutcome, Verdict
@@ -21,7 +22,7 @@ from gearcheck.results import Comparison, Plot, Report, Series, SweepOutcome, Ve
 def report(params, outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Report:
     data: SweepData = outcome.data
     return Report(rows(data), comparisons(params, data, outcome.summary), plots(params, data),
-                  notes(params, data, outcome.summary))
+                  notes(params, data, outcome.summary), tca_overlays(data.tca, data.specs))
 
 
 def rows(data: SweepData) -> list[dict]:
@@ -135,6 +136,7 @@ def plots(params, data: SweepData) -> list[Plot]:
               Series("paper model (clean eq 9)", list(shims), [m.clean_drop for m in models])],
              markers=[("template shim", data.template_shim_mm)]),
         *_temperature_plots(params, data),
+        *(tca_plots(data.tca) if data.tca else []),
     ]
 
 

@@ -1,18 +1,21 @@
 """The differential's bevel pair under tooth contact analysis (:mod:`gearcheck.geometry.bevel_tca`):
-its transmission error and contact path as designed and under each mounting error alone, for
-summary.json ``tca``."""
+its transmission error and contact path as designed and under each mounting error alone, and at
+each thermal state the check meshes its mounting, TE and contact pattern, for summary.json ``tca``
+and the report."""
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry import bevel_tca as bt
 from gearcheck.geometry.bevel_mesh import drive_poses
-from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses
-from gearcheck.mechanisms.differential.temperature import placed_gears
+from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses, gear_specs
+from gearcheck.mechanisms.differential.temperature import (MESH_DECIDED_STATES, key_temperatures, meshed_states,
+                                                           placed_gears)
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
 
 # Each mounting error at the size the figures are quoted per: 10 µm of E, P, G, 0.01° of Σ.
@@ -77,3 +80,122 @@ def state_summary(params, specs: GearSpecs, shim_mm: float, temperature_C: float
             "coast_te_pp_urad": urad * float(np.max(np.ptp(coast, axis=0))),
             "drive_te_mean_urad": urad * float(np.mean(drive)), "coast_te_mean_urad": urad * float(np.mean(coast)),
             "least_play_arcmin": float(np.min(coast - drive))}
+
+
+# The states the pattern requirement holds at: the gears run there (storage is not running).
+RUNNING_STATES = MESH_DECIDED_STATES
+FLANKS = ("drive", "coast")
+
+
+@dataclass(frozen=True)
+class PairTca:
+    """The pair at one mounting (as designed, or a thermal state's): TE and contact path over two
+    mesh cycles, and the contact pattern of each flank of the big gear's tooth."""
+
+    name: str
+    temperature_C: float  # nan: as designed (no thermal state)
+    mounting: bt.Mounting
+    te: bt.TransmissionError
+    patterns: dict[str, bt.ContactPattern]
+
+
+def pair_tca(specs: GearSpecs, mounting: bt.Mounting, name: str, temperature_C: float = math.nan,
+             compound_mm: float = bt.COMPOUND_MM, *, steps: int = bt.PATTERN_STEPS,
+             grid: tuple[int, int] = (bt.PATTERN_PROFILE, bt.PATTERN_RULING)) -> PairTca:
+    """TE and both flanks' patterns of the pair as ``mounting`` places it (``steps`` drive angles a
+    cycle and a ``grid`` of profile × ruling points for the pattern)."""
+    te = bt.mounted_transmission_error(specs.big, specs.small, mounting, CYCLES, PER_CYCLE)
+    return PairTca(name, temperature_C, mounting, te,
+                   {f: bt.contact_pattern(specs.big, specs.small, mounting, te, f, compound_mm, steps, *grid)
+                    for f in FLANKS})
+
+
+def state_tca(params, specs: GearSpecs, shim_mm: float, name: str, temperature_C: float, *,
+              steps: int = bt.PATTERN_STEPS, grid: tuple[int, int] = (bt.PATTERN_PROFILE, bt.PATTERN_RULING)
+              ) -> PairTca:
+    """:func:`pair_tca` at a thermal state's mounting (:func:`state_mounting`) with the template's
+    mounting errors (``[tca]``: E/P/G/Σ) on top, under its marking compound."""
+    m = state_mounting(params, specs, shim_mm, temperature_C)
+    big_error, small_error = bt.Misalignment(*params.tca.mounting_errors).displacements()
+    mounting = bt.Mounting.of(bt.Misalignment(m["offset_mm"], m["small_axial_mm"], m["big_axial_mm"],
+                                              m["shaft_angle_rad"]), m["big_scale"], m["small_scale"],
+                              big_error, small_error)
+    return pair_tca(specs, mounting, name, temperature_C, params.tca.compound_um * 1e-3, steps=steps, grid=grid)
+
+
+def pattern_summary(p: bt.ContactPattern) -> dict[str, float]:
+    """One flank's pattern for summary.json: its span (toe 0 … heel 1, root 0 … tip 1), length
+    (share of the face width), centre, share of the flank's area, and 1/0 for reaching the toe,
+    the heel, the tip and running below the form line."""
+    e = p.extent()
+    return {"along_min": e["along_min"], "along_max": e["along_max"], "length": e["along_max"] - e["along_min"],
+            "centre_along": e["centre_along"], "height_min": e["height_min"], "height_max": e["height_max"],
+            "centre_height": e["centre_height"], "area_share": e["area_share"],
+            **{f"reaches_{k}": float(e[k]) for k in ("toe", "heel", "tip")}, "below_form": float(e["below_form"])}
+
+
+def patterns_summary(pairs: list[PairTca]) -> dict[str, dict[str, dict[str, float]]]:
+    """summary.json ``tca.patterns``: each pair's (aligned, each state's) patterns of both flanks."""
+    return {t.name: {f: pattern_summary(p) for f, p in t.patterns.items()} for t in pairs}
+
+
+def mounted_summary(pairs: list[PairTca]) -> dict[str, dict[str, float]]:
+    """summary.json ``tca.mounted``: each pair's TE figures (:func:`curve_summary`: one big gear
+    with one small gear) as designed and at each state with the template's mounting errors."""
+    return {t.name: curve_summary(t.te) for t in pairs}
+
+
+def sensitivity(specs: GearSpecs, pair: PairTca) -> dict[str, dict[str, float]]:
+    """Each mounting error of :data:`STEPS` added to a pair's mounting: the TE peak to peak of
+    both flanks (µrad) and the least play (arcmin), and their change from the pair's own."""
+    base = curve_summary(pair.te)
+    out = {}
+    for name, step in STEPS.items():
+        big, small = step.displacements()
+        m = pair.mounting
+        mounted = bt.Mounting(big @ m.big_displacement, small @ m.small_displacement, m.big_scale, m.small_scale)
+        got = curve_summary(bt.mounted_transmission_error(specs.big, specs.small, mounted, CYCLES, PER_CYCLE))
+        out[name] = {**{k: got[k] for k in ("drive_te_pp_urad", "coast_te_pp_urad", "least_play_arcmin")},
+                     **{f"{k}_change": got[k] - base[k]
+                        for k in ("drive_te_pp_urad", "coast_te_pp_urad", "least_play_arcmin")}}
+    return out
+
+
+# A study's variants: a coarser pattern (its edges to 1/28 of the face, 1/40 of the height).
+STUDY_STEPS, STUDY_GRID = 24, (41, 29)
+STUDY_KEYS = ("te_pp_urad", "warm_te_pp_urad", "cold_te_pp_urad", "pattern_length", "pattern_reaches_tip",
+              "pattern_end_bearing")
+
+
+def study_figures(params, specs: GearSpecs) -> dict[str, float]:
+    """A study variant's tooth contact figures at the template's shim and mounting errors, over the
+    running states: the largest TE peak to peak of either flank (one big gear with one small
+    gear, µrad), the drive flank's warm and cold, the least pattern length (share of the face,
+    either flank), and 1/0: a pattern reaches the tip edge; a pattern bears on one end (reaches
+    the toe or the heel but not both)."""
+    temps = key_temperatures(params)
+    seen: dict[float, PairTca] = {}
+    pairs = {}
+    for name in RUNNING_STATES:
+        t = float(temps[name])
+        if t not in seen:
+            seen[t] = state_tca(params, specs, params.shim.thickness_mm, name, t, steps=STUDY_STEPS, grid=STUDY_GRID)
+        pairs[name] = seen[t]
+    extents = [p.extent() for pair in seen.values() for p in pair.patterns.values()]
+    return {"te_pp_urad": 1e6 * float(max(max(np.ptp(p.te.drive_rad), np.ptp(p.te.coast_rad)) for p in seen.values())),
+            "warm_te_pp_urad": 1e6 * float(np.ptp(pairs["warm"].te.drive_rad)),
+            "cold_te_pp_urad": 1e6 * float(np.ptp(pairs["cold"].te.drive_rad)),
+            "pattern_length": min((e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0 for e in extents),
+            "pattern_reaches_tip": float(any(e["tip"] for e in extents)),
+            "pattern_end_bearing": float(any(e["toe"] != e["heel"] for e in extents))}
+
+
+def design_tca(params) -> dict[str, PairTca]:
+    """The pair as designed ("aligned") and at each state the check meshes, at the template's shim
+    with its mounting errors: what :meth:`gearcheck.design.Design.tca` returns (the check's
+    ``tca`` figures are these)."""
+    specs = gear_specs(params)
+    out = {"aligned": pair_tca(specs, bt.Mounting.of(), "aligned", compound_mm=params.tca.compound_um * 1e-3)}
+    for name, temp in meshed_states(params):
+        out[name] = state_tca(params, specs, params.shim.thickness_mm, name, temp)
+    return out

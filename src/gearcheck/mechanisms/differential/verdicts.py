@@ -19,7 +19,8 @@ import math
 import numpy as np
 
 from gearcheck.mechanisms.differential.reduce import AGREEMENT_RELATIVE, SweepData
-from gearcheck.mechanisms.differential.temperature import ONSET_TOL_K, shim_text
+from gearcheck.mechanisms.differential.tca import RUNNING_STATES
+from gearcheck.mechanisms.differential.temperature import ONSET_TOL_K, STATE_TEXT, shim_text
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS
 from gearcheck.results import SweepOutcome, Verdict
 
@@ -45,8 +46,47 @@ def verdicts(params, outcome: SweepOutcome) -> list[Verdict]:
     data: SweepData = outcome.data
     resolves = bool(getattr(outcome, "mesh_resolves", True))
     requirement = _cold_requirement(params, data, resolves)
+    pattern = _pattern(params, data)
     return [_warm(data, resolves), _cold(data, resolves), *([requirement] if requirement else []),
-            _operating(params, data, resolves), _storage(params, data), _agreement(data)]
+            *([pattern] if pattern else []), _operating(params, data, resolves), _storage(params, data),
+            _agreement(data)]
+
+
+def _pattern(params, data: SweepData) -> Verdict | None:
+    """The template's ``[tca] pattern_min_length``: at every running state the check meshes,
+    the pattern of both flanks of the big gear's tooth covers at least that share of the face
+    width and stays on the involute (never below the form line). Short: the template's level."""
+    spec = params.tca
+    required = spec.pattern_min_length
+    if required is None:
+        return None
+    running = [p for p in data.tca if p.name in RUNNING_STATES]
+    if not running:
+        return None
+    worst, where, parts, below = math.inf, "", [], []
+    for pair in running:
+        ext = {f: p.extent() for f, p in pair.patterns.items()}
+        length = min((e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0 for e in ext.values())
+        state = f"{STATE_TEXT[pair.name]} {pair.temperature_C:g} °C"
+        if length < worst:
+            worst, where = length, state
+        drive = ext["drive"]
+        ends = " and ".join(w for w in ("toe", "heel") if drive[w])
+        reach = f", reaches the {ends}" if ends else ""
+        parts.append(f"{state} {length:.0%} (centre {drive['centre_along']:.2f}{reach})")
+        below += [f"{STATE_TEXT[pair.name]} {f}" for f, e in ext.items() if e["below_form"]]
+    met = worst >= required and not below
+    measured = (f"least pattern length {worst:.0%} of the face ({where}), both flanks under {spec.compound_um:g} µm "
+                "of compound (centre: toe 0 … heel 1): " + "; ".join(parts)
+                + (f"; below the form line: {', '.join(below)}" if below
+                   else "; on the involute at every running state"))
+    short = (f"pattern length {worst:.0%} of the face, required ≥ {required:.0%}" if worst < required
+             else f"pattern below the form line ({', '.join(below)})")
+    return Verdict.graded("contact_pattern", f"contact pattern bears over ≥ {required:.0%} of the face at "
+                          "every running state, on the involute", "pass" if met else spec.level, measured,
+                          {"least_length": worst, "required": required},
+                          "exact model (the gap to the mating spherical-involute flank over a whole pass of the "
+                          "tooth, no mesh)", "" if met else short)
 
 
 def _cold_requirement(params, data: SweepData, resolves: bool) -> Verdict | None:
