@@ -229,5 +229,17 @@ def test_the_transmission_error_of_the_towing_swing_and_the_power_stroke(geometr
 
 @pytest.mark.cad
 def test_the_check_reports_the_transmission_error(coarse):
+    """summary.json ``tca``: the towing swing and the power stroke, as designed and under each
+    mounting error (centre-distance errors of ±0.1 mm, a tilt of 0.1°)."""
+    from gearcheck.mechanisms.steering.tca import CENTRE_ERRORS_MM, TILTS_DEG
+
     outcome, _ = coarse
-    assert set(outcome.summary["tca"]) == {"towing", "power"}
+    tca = outcome.summary["tca"]
+    errors = {name for name, _ in CENTRE_ERRORS_MM + TILTS_DEG}
+    assert set(tca) == {"towing", "power"} | errors
+    assert errors == {"centre_error_0p1mm", "centre_error_m0p1mm", "tilt_0p1deg"}
+    for name in errors:
+        assert set(tca[name]["towing"]) >= {"conjugate_te_pp_mm", "te_departs_deg", "te_at_disengage_mm",
+                                            "continuous_drive_end_deg"}
+        assert tca[name]["towing"]["conjugate_te_pp_mm"] <= 1e-9
+    assert tca["centre_error_0p1mm"]["fits"] and not tca["centre_error_m0p1mm"]["fits"]

@@ -3,15 +3,24 @@
 Frame (millimetres, radians unless a name says ``_deg``):
 
 * x along the rack travel, y up; the origin lies on the rack datum (its mounting face, y = 0)
-  straight under the pinion centre, which is at ``(0, H)``.
+  straight under the pinion centre, which is at ``(0, H + Δa)``: H the designed centre height
+  (``centre_to_datum_mm``), Δa the mounting error (``centre_error_mm``, 0 as designed). The rack
+  and the pinion as made do not depend on Δa: the rack's teeth are drawn from H (its designed
+  rolling line H − r), the trims are absolute heights; only the pinion centre moves, and with it
+  the line that rolls on the pitch circle (``rolling_line_height``, H + Δa − r).
 * The rack moves by ``travel`` L along +x; the pinion turns by φ counter-clockwise (seen with y
-  up), so its lowest point moves +x with the rack: conjugate mesh is ``L = r·φ``.
+  up), so its lowest point moves +x with the rack: conjugate mesh is ``L = r·φ`` (as designed).
 * Polar angles γ about the pinion centre are measured from straight down, counter-clockwise:
-  a point at radius ρ and angle γ is ``(ρ sin γ, H − ρ cos γ)``.
+  a point at radius ρ and angle γ is ``(ρ sin γ, H + Δa − ρ cos γ)``.
 * Angle 0 (φ = 0, L = 0): rack tooth k = 0 is centred under the pinion centre, so a pinion space
   is centred straight down. Rack tooth k is centred at ``x = k·p + L``; pinion tooth j is
   centred at ``γ = (j + ½)·τ + φ`` (τ = 2π/z), i.e. pinion tooth j sits in the rack space
   between rack teeth k = j and k = j + 1.
+* As designed (Δa = 0) the flanks mesh at zero backlash, conjugate ``L = r·φ``. With Δa the
+  involute pinion and the straight-flanked rack still mesh conjugate (the pitch circle rolls on
+  the line H + Δa − r), each rack flank off its conjugate place by Δa·tan α in travel
+  (``flank_offset``): towing ``L = r·φ − Δa·tan α``, power mode ``L = r·φ + Δa·tan α``, the
+  backlash 2·Δa·tan α (Δa < 0: the teeth overlap, the mesh binds).
 
 Trims (paper fig. 5; indices for the template's rack k = −7…7, pinion sector j = −8…7):
 the first rack tooth (k = −7) has its left top corner S2 at height hS2 and its right top corner
@@ -67,6 +76,9 @@ class RackPinionGeometry:
     hS4_mm: float
     hS6_mm: float
     hS8_mm: float
+    # Δa: the pinion centre sits this much farther from the rack than designed (a mounting error;
+    # the rack and the pinion as made are unchanged)
+    centre_error_mm: float = 0.0
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     # --- derived dimensions -------------------------------------------------------------
@@ -111,14 +123,32 @@ class RackPinionGeometry:
         return self.module_mm * (math.pi / 2.0 + 2.0 * self.profile_shift * math.tan(self.pressure_angle_rad))
 
     @property
+    def centre_height(self) -> float:
+        """H + Δa: the height of the pinion centre above the rack datum, as mounted."""
+        return self.centre_to_datum_mm + self.centre_error_mm
+
+    @property
     def rolling_line_height(self) -> float:
-        """h = H − r: the rack line that rolls on the pitch circle (paper's 'pitch line' h)."""
+        """h = H + Δa − r: the rack line that rolls on the pitch circle (paper's 'pitch line' h), the
+        kinematic pitch line; the line of action passes through (0, h)."""
+        return self.centre_height - self.pitch_radius
+
+    @property
+    def made_rolling_line_height(self) -> float:
+        """H − r: the rolling line as designed, the line the rack's teeth are drawn from (the rack
+        as made); equal to :attr:`rolling_line_height` at Δa = 0."""
         return self.centre_to_datum_mm - self.pitch_radius
 
     @property
+    def flank_offset(self) -> float:
+        """Δa·tan α: rack travel by which each rack flank lies off its conjugate place (towing, the
+        rack lags by it; power mode, the rack must run it ahead); the backlash is twice it."""
+        return self.centre_error_mm * math.tan(self.pressure_angle_rad)
+
+    @property
     def rack_reference_height(self) -> float:
-        """Height of the rack's own reference line (tooth = space = p/2): h − x·m."""
-        return self.rolling_line_height - self.profile_shift * self.module_mm
+        """Height of the rack's own reference line (tooth = space = p/2): H − r − x·m."""
+        return self.made_rolling_line_height - self.profile_shift * self.module_mm
 
     @property
     def rack_top_height(self) -> float:
@@ -130,7 +160,8 @@ class RackPinionGeometry:
 
     @property
     def rack_half_thickness_at_rolling_line(self) -> float:
-        """Zero backlash: rack tooth = pinion space on the pitch circle, (p − s)/2 per side."""
+        """Zero backlash as designed: rack tooth on its designed rolling line = pinion space on the
+        pitch circle, (p − s)/2 per side."""
         return (self.pitch - self.pinion_pitch_thickness) / 2.0
 
     @property
@@ -155,10 +186,10 @@ class RackPinionGeometry:
         return depth > self.pitch_radius * math.sin(self.pressure_angle_rad) ** 2
 
     def rack_half_width(self, y):
-        """Half width of a standard rack tooth at height y (straight flanks at α)."""
+        """Half width of a standard rack tooth at height y (straight flanks at α; the rack as made)."""
         a = self.pressure_angle_rad
         return (self.rack_half_thickness_at_rolling_line
-                - (np.asarray(y, dtype=float) - self.rolling_line_height) * math.tan(a))
+                - (np.asarray(y, dtype=float) - self.made_rolling_line_height) * math.tan(a))
 
     # --- pinion ---------------------------------------------------------------------------
     def involute_half_angle(self, rho):
@@ -182,7 +213,7 @@ class RackPinionGeometry:
         """Points at radius ρ and polar angle γ (from straight down, CCW) about the pinion centre."""
         rho = np.asarray(rho, dtype=float)
         gamma = np.asarray(gamma, dtype=float)
-        return np.stack([rho * np.sin(gamma), self.centre_to_datum_mm - rho * np.cos(gamma)], axis=-1)
+        return np.stack([rho * np.sin(gamma), self.centre_height - rho * np.cos(gamma)], axis=-1)
 
     def _involute_radii(self, r_low: float, r_tip: float, n: int) -> np.ndarray:
         """Radii from r_low to r_tip, evenly spaced in roll angle (denser arc length near the
@@ -333,7 +364,7 @@ class RackPinionGeometry:
 # --- pinion tooth pieces for a B-rep (pure; consumed by gearcheck.cad.rack_pinion) -----------
 # The pinion's own frame: centre at the origin, polar angle γ from straight down (−y),
 # counter-clockwise; tooth j's centre line at γ = (j + ½)·τ. The world pinion at angle φ is this
-# frame turned by φ about its axis and moved to (0, H).
+# frame turned by φ about its axis and moved to (0, H + Δa).
 
 @dataclass(frozen=True)
 class ToothPiece:
@@ -429,11 +460,11 @@ class RackSpec:
 
 
 def pinion_pose(g: RackPinionGeometry, phi: float) -> np.ndarray:
-    """Pinion frame → world at pinion angle φ (counter-clockwise about z, centre at (0, H, 0))."""
+    """Pinion frame → world at pinion angle φ (counter-clockwise about z, centre at (0, H + Δa, 0))."""
     c, s = math.cos(phi), math.sin(phi)
     pose = np.eye(4)
     pose[:2, :2] = [[c, -s], [s, c]]
-    pose[1, 3] = g.centre_to_datum_mm
+    pose[1, 3] = g.centre_height
     return pose
 
 

@@ -105,7 +105,7 @@ class ToothPairs:
     def apart(self, phi, travel) -> np.ndarray:
         """A lower bound (..., P) of each pair's signed clearance: the gap between the circles that
         hold the two teeth."""
-        centre = np.array([0.0, self.g.centre_to_datum_mm]) + self.hub[:, None] * direction(self.theta(phi))
+        centre = np.array([0.0, self.g.centre_height]) + self.hub[:, None] * direction(self.theta(phi))
         rack = self.rack_centre + np.stack([np.asarray(travel, dtype=float), np.zeros_like(travel)],
                                            axis=-1)[..., None, :]
         return np.linalg.norm(centre - rack, axis=-1) - self.hub_radius - self.rack_radius
@@ -159,7 +159,7 @@ class ToothPairs:
         rho = np.where(piece <= 1, r_tip, np.where(piece == 2, rho_inv, self.r_form))
         beta = np.where(piece <= 1, b_tip, np.where(piece == 2, self.g.involute_half_angle(rho_inv), self.beta_form))
         rel = np.where(piece == 0, wrapped(delta), side * beta)
-        return np.array([0.0, self.g.centre_to_datum_mm]) + rho[..., None] * direction(self.theta(phi) + rel)
+        return np.array([0.0, self.g.centre_height]) + rho[..., None] * direction(self.theta(phi) + rel)
 
     # --- separations -----------------------------------------------------------------------
     def separation(self, phi, travel, psi, corners=(0, 1, 2, 3)) -> np.ndarray:
@@ -173,7 +173,7 @@ class ToothPairs:
         v = self.vertices[:, list(corners)]
         vx, vy = v[:, None, :, 0], v[:, None, :, 1]  # (P, 1, m)
         rack = np.min(e[..., 0, None] * vx + e[..., 1, None] * vy, axis=-1) + e[..., 0] * travel
-        return rack - self.g.centre_to_datum_mm * e[..., 1] - self.h(psi - self.theta(phi)[..., None])
+        return rack - self.g.centre_height * e[..., 1] - self.h(psi - self.theta(phi)[..., None])
 
     def candidates(self, phi, travel) -> np.ndarray:
         """Directions ψ (..., P, 38) among which each pair's signed clearance is attained."""
@@ -181,7 +181,7 @@ class ToothPairs:
         travel = np.asarray(travel, dtype=float)[..., None, None]
         qx = self.vertices[..., 0] + travel  # (..., P, 4)
         qy = np.broadcast_to(self.vertices[..., 1], qx.shape)
-        rel = np.stack([qx, qy - self.g.centre_to_datum_mm], axis=-1)
+        rel = np.stack([qx, qy - self.g.centre_height], axis=-1)
         rho = np.hypot(rel[..., 0], rel[..., 1])
         gam = angle_of(rel)
         tangent = np.arcsin(np.clip(self.r_base / rho, -1.0, 1.0))

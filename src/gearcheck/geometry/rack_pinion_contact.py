@@ -80,7 +80,9 @@ def pair_contact(g: RackPinionGeometry, mode: str, j: int, k: int) -> PairContac
     """Exact conjugate contact interval of pinion tooth j and rack tooth k. Towing (k = j + 1):
     the pinion's right flank pushes the rack's left flank, line of action through P = (0, h) along
     (cos α, −sin α); power (k = j): the rack's right flank pushes the pinion's left flank, along
-    (cos α, sin α). A point at t on it lies at radius √(rb² + (r sin α ± t)²) from the centre."""
+    (cos α, sin α). A point at t on it lies at radius √(rb² + (r sin α ± t)²) from the centre.
+    h = H + Δa − r: the line of action is fixed to the pinion, so φ(t) is the pinion's alone and
+    a centre-distance error moves only where the rack's root and top corners meet it."""
     a = g.pressure_angle_rad
     sa, ca = math.sin(a), math.cos(a)
     h, rb, r = g.rolling_line_height, g.base_radius, g.pitch_radius

@@ -21,29 +21,30 @@ def phi_power_conjugate_end(g: RackPinionGeometry, k: int, h_corner: float) -> f
     """Pinion angle at which the conjugate contact on rack tooth k's power-side (right) flank
     reaches its top corner at ``h_corner`` (S6 for the first tooth, eq (19)): the contact
     point is at t = (h_c − h)/sin α on the power line of action, where the flank
-    x = k·p + L + w(h_c) passes; φ = L/r."""
+    x = k·p + L + w(h_c) passes; φ = (L − Δa·tan α)/r (:attr:`RackPinionGeometry.flank_offset`)."""
     a = g.pressure_angle_rad
     t = (h_corner - g.rolling_line_height) / math.sin(a)
     travel = t * math.cos(a) - k * g.pitch - float(g.rack_half_width(h_corner))
-    return travel / g.pitch_radius
+    return (travel - g.flank_offset) / g.pitch_radius
 
 
 def power_corner(g: RackPinionGeometry) -> tuple[float, float, float]:
     """S6 of the first rack tooth: x in the rack frame, its depth below the pinion centre
-    (H − hS6), and the travel at which it leaves the pinion's tip circle (the pinion is released)."""
+    (H + Δa − hS6), and the travel at which it leaves the pinion's tip circle (the pinion is released)."""
     x0 = g.rack_first_tooth * g.pitch + float(g.rack_half_width(g.hS6_mm))
-    dy = g.centre_to_datum_mm - g.hS6_mm
+    dy = g.centre_height - g.hS6_mm
     return x0, dy, math.sqrt(g.tip_radius ** 2 - dy ** 2) - x0
 
 
 def power_model_angle(g: RackPinionGeometry, travel: float) -> float:
-    """Pinion angle driven by the rack (φ > 0, L > 0): conjugate L/r up to the S6 engagement
-    (eq 19); beyond it the corner S6 = (k·p + L + w(hS6), hS6) rides on the left involute flank of
-    pinion tooth j = k (k = rack.first_tooth): φ = γ(S6) + β(ρ(S6)) − (j + ½)·τ, until S6 leaves
-    the tip circle and the pinion stops."""
+    """Pinion angle driven by the rack (φ > 0, L > 0): conjugate (L − Δa·tan α)/r (the pinion held
+    against the driving flank) up to the S6 engagement (eq 19); beyond it the corner
+    S6 = (k·p + L + w(hS6), hS6) rides on the left involute flank of pinion tooth j = k
+    (k = rack.first_tooth): φ = γ(S6) + β(ρ(S6)) − (j + ½)·τ, until S6 leaves the tip circle and
+    the pinion stops."""
     k = g.rack_first_tooth
-    if travel <= phi_power_conjugate_end(g, k, g.hS6_mm) * g.pitch_radius:
-        return travel / g.pitch_radius
+    if travel <= phi_power_conjugate_end(g, k, g.hS6_mm) * g.pitch_radius + g.flank_offset:
+        return (travel - g.flank_offset) / g.pitch_radius
     x0, dy, release = power_corner(g)
     x = x0 + min(travel, release)
     rho = math.hypot(x, dy)
@@ -55,13 +56,14 @@ def power_model_travel(g: RackPinionGeometry, angle: float) -> float:
     ``angle`` (NaN at or past the release, where any further travel gives the same angle)."""
     end = phi_power_conjugate_end(g, g.rack_first_tooth, g.hS6_mm)
     if angle <= end:
-        return angle * g.pitch_radius
+        return angle * g.pitch_radius + g.flank_offset
     release = power_corner(g)[2]
     if angle >= power_model_angle(g, release):
         return math.nan
     from scipy.optimize import brentq  # lazy: sweep workers import this module and never call it
 
-    return float(brentq(lambda t: power_model_angle(g, t) - angle, end * g.pitch_radius, release, xtol=1e-10))
+    return float(brentq(lambda t: power_model_angle(g, t) - angle, end * g.pitch_radius + g.flank_offset,
+                        release, xtol=1e-10))
 
 
 def tangency_offset(profile_world: np.ndarray, near: np.ndarray, normal: np.ndarray, corner: np.ndarray,

@@ -161,12 +161,12 @@ def travel_corner_on_circle(g: RackPinionGeometry, k: int, h_corner: float, radi
     ``h_corner``, lies on the circle of ``radius`` about the pinion centre, right of it.
     For k = first + 1, Ra, hS4 this is eq (3); for k = first, RS1, hS2 eqs (4)/(22):
     L = −k·p + s/2 − (h_c − h)·tan α + R·sin θ,  R·cos θ = H − h_c."""
-    x_on_circle = math.sqrt(radius * radius - (g.centre_to_datum_mm - h_corner) ** 2)
+    x_on_circle = math.sqrt(radius * radius - (g.centre_height - h_corner) ** 2)
     return x_on_circle - k * g.pitch + float(g.rack_half_width(h_corner))
 
 
 def _polar_angle(g: RackPinionGeometry, point) -> float:
-    return math.atan2(point[0], g.centre_to_datum_mm - point[1])
+    return math.atan2(point[0], g.centre_height - point[1])
 
 
 def phi_towing_conjugate_end(g: RackPinionGeometry, j: int, radius: float | None = None) -> float:
@@ -251,15 +251,15 @@ def disengage_closed_form(g: RackPinionGeometry) -> tuple[float, float]:
 
 def towing_travel_closed_form(g: RackPinionGeometry, phi) -> np.ndarray:
     """Towing curve written out for the paper's mechanism story, to cross-check the push model:
-    L = r·φ up to the S1 engagement; then G1's right tip corner S1 = (x1, y1) drags the first
-    rack tooth's left flank, L = x1 − k·p + w(y1); from the disengage angle the rack stands."""
+    L = r·φ − Δa·tan α up to the S1 engagement; then G1's right tip corner S1 = (x1, y1) drags the
+    first rack tooth's left flank, L = x1 − k·p + w(y1); from the disengage angle the rack stands."""
     phi = np.asarray(phi, dtype=float)
     j, k = g.sector_first_tooth, g.rack_first_tooth
     phi_s1 = phi_towing_conjugate_end(g, j)
     phi_dis, travel_dis = disengage_closed_form(g)
     corner = g.pinion_tip_corner(j, phi)
     dragged = corner[..., 0] - k * g.pitch + g.rack_half_width(corner[..., 1])
-    return np.where(phi <= phi_s1, g.pitch_radius * phi, np.where(phi < phi_dis, dragged, travel_dis))
+    return np.where(phi <= phi_s1, g.pitch_radius * phi - g.flank_offset, np.where(phi < phi_dis, dragged, travel_dis))
 
 
 def tangent_top_height(g: RackPinionGeometry, corner, k: int, travel: float,
@@ -270,9 +270,9 @@ def tangent_top_height(g: RackPinionGeometry, corner, k: int, travel: float,
     ``flank_through_centre`` draws the flank through the tooth centre on the pitch line,
     as the paper's lines (9)/(16) do (half a tooth off)."""
     qx, qy = float(corner[0]), float(corner[1])
-    slope = qx / (g.centre_to_datum_mm - qy)
+    slope = qx / (g.centre_height - qy)
     tan_a = math.tan(g.pressure_angle_rad)
-    h = g.rolling_line_height
+    h = g.made_rolling_line_height  # the flank as made
     half = 0.0 if flank_through_centre else g.rack_half_thickness_at_rolling_line
     # flank: x = c + half − (y − h)·tan α;  tangent: y = qy + slope·(x − qx)
     c = k * g.pitch + travel
@@ -295,7 +295,7 @@ def solve_trims(g: RackPinionGeometry, min_contact_ratio: float, target_angle: f
     equals the target (its smallest, lightest value); hS2 so that S1 reaches S2 at the same
     rack travel (eq (4), shortest travel). NaN where no value in the physical range works."""
     first = g.rack_first_tooth
-    H = g.centre_to_datum_mm
+    H = g.centre_height
     hS4 = trim_height_for_contact_ratio(g, min_contact_ratio)
     travel = travel_corner_on_circle(g, first + 1, hS4, g.tip_radius)
 
@@ -312,7 +312,7 @@ def solve_trims(g: RackPinionGeometry, min_contact_ratio: float, target_angle: f
         def travel_miss(h_corner: float) -> float:
             return travel_corner_on_circle(g, first, h_corner, rs1) - travel
 
-        h_lo = max(g.rolling_line_height, H - rs1) + 1e-9
+        h_lo = max(g.made_rolling_line_height, H - rs1) + 1e-9
         h_hi = g.rack_top_height
         if h_lo < h_hi and travel_miss(h_lo) < 0 < travel_miss(h_hi):
             hS2 = float(_brentq()(travel_miss, h_lo, h_hi, xtol=1e-12))

@@ -36,9 +36,9 @@ class SteeringLayout:
 
 
 def assembly(params) -> Assembly:
-    """Pinion (turns about z through (0, H, 0)) and rack (slides along x), posed at angle 0."""
+    """Pinion (turns about z through (0, H + Δa, 0)) and rack (slides along x), posed at angle 0."""
     g = an.geometry_from_params(params)
-    H = g.centre_to_datum_mm
+    H = g.centre_height
     pinion = PartSpec(PINION, PINION, lay.PINION_MATERIAL, rp.pinion_pose(g, 0.0),
                       motion=Rotation.about((0.0, 0.0, 1.0), (0.0, float(H), 0.0)))
     rack = PartSpec(RACK, RACK, lay.RACK_MATERIAL, rp.rack_pose(0.0), motion=Translation.along((1.0, 0.0, 0.0)))

@@ -23,7 +23,7 @@ def calc(params: Params) -> list[Figure]:
     P = an.PAPER
     g = an.geometry_from_params(params)
     first_k, first_j = g.rack_first_tooth, g.sector_first_tooth
-    H, h, rs1 = g.centre_to_datum_mm, g.rolling_line_height, g.topped_radius_mm
+    H, h, rs1 = g.centre_height, g.rolling_line_height, g.topped_radius_mm
     tan_a = math.tan(g.pressure_angle_rad)
 
     # --- trimming design chain (solved) and the machined travels ---------------------------

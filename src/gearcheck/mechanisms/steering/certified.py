@@ -244,7 +244,7 @@ class _Stroke:
         is pushed +x, the left one −x), its radius, its abscissa and depth below the centre."""
         tp = st.tp
         x = tp.vertices[:, vertex, 0] + travel
-        c = self.g.centre_to_datum_mm - tp.vertices[:, vertex, 1]
+        c = self.g.centre_height - tp.vertices[:, vertex, 1]
         rho = np.hypot(x, c)
         beta = self.g.involute_half_angle(np.maximum(rho, tp.r_base))
         return np.arctan2(x, c) - self.side * beta - tp.theta0, rho, x, c
@@ -379,7 +379,7 @@ class _Stroke:
         if motion is None and self.mode == "power":
             return phi, _power_travel(self.g, a, b, phi)
         if motion is not None and motion.kind in ("stand", "rolling"):
-            return phi, a.travel if motion.kind == "stand" else self.g.pitch_radius * phi
+            return phi, a.travel if motion.kind == "stand" else self.g.pitch_radius * phi + self.g.flank_offset
         if motion is not None and motion.pushing is not None:  # the pushers' contact travel (the farthest)
             contact = -st.tp.separation(phi, 0.0, st.flank[:, None])[..., 0] / st.ex
             return phi, float(np.where(motion.pushing, contact * self.side, -np.inf).max() * self.side)

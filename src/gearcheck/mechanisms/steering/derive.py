@@ -160,12 +160,12 @@ def shortest_stroke_height(g: RackPinionGeometry) -> tuple[float, str]:
     first = g.rack_first_tooth
     travel = an.travel_corner_on_circle(g, first + 1, g.hS4_mm, g.tip_radius)
     rs1 = g.topped_radius_mm
-    top, h = g.rack_top_height, g.rolling_line_height
+    top, h = g.rack_top_height, g.made_rolling_line_height
 
     def miss(height: float) -> float:
         return an.travel_corner_on_circle(g, first, height, rs1) - travel
 
-    lo = max(h, g.centre_to_datum_mm - rs1) + 1e-9
+    lo = max(h, g.centre_height - rs1) + 1e-9
     if lo >= top or miss(lo) > 0:
         return math.nan, (f"S1 on the RS1 = {rs1:g} mm circle reaches S2 after the S3/S4 travel "
                           f"{travel:.3f} mm at every height above the rolling line")
@@ -270,7 +270,7 @@ def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str]
         if math.isnan(hs2):
             raise NoDesign(how)
         notes["trim.hS2_mm"] = f"shortest stroke: {how}"
-    if not g.centre_to_datum_mm - hs2 < rs1:
+    if not g.centre_height - hs2 < rs1:
         raise NoDesign(f"G1's tip circle (RS1 = {rs1:g} mm) does not reach S2 at hS2 = {hs2:g} mm")
     v["trim.hS4_mm"], v["pinion.topped_radius_mm"], v["trim.hS2_mm"] = hs4, rs1, hs2
     return an.with_inputs(g, hS2_mm=hs2)
@@ -303,7 +303,7 @@ def _tops(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str], given
             notes[key] = f"untrimmed (rack top): the {circle} tip land clears the whole top"
             continue
         value = _down(bound - margin)
-        if not value > g.rolling_line_height:
+        if not value > g.made_rolling_line_height:
             raise NoDesign(f"the tip land leaves no trimmed top above the rolling line at {corner}")
         v[key] = value
         notes[key] = (f"tangent to the {circle} circle at {corner} meets the flank at {tangent:.3f} mm, "

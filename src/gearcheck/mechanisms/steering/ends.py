@@ -113,7 +113,7 @@ def _corner_event(g: RackPinionGeometry, j: int, k: int) -> tuple[float, float]:
     radius = g.pinion_tip_radius(j)
     travel = travel_corner_on_circle(g, k, h_corner, radius)
     x = k * g.pitch + travel - float(g.rack_half_width(h_corner))
-    polar = math.atan2(x, g.centre_to_datum_mm - h_corner)
+    polar = math.atan2(x, g.centre_height - h_corner)
     return polar - float(g.involute_half_angle(radius)) - (j + 0.5) * g.angular_pitch, travel
 
 
@@ -171,7 +171,7 @@ def _swept_depth(g: RackPinionGeometry, j: int, stand: Stand, points: np.ndarray
     """How deep the points lie inside the region pinion tooth j sweeps over the stand (> 0: inside),
     in mm: the least of their depth inside its tip circle and their arc distance inside the polar
     angles its flanks cover, the left flank at the start and the right flank at the end."""
-    H = g.centre_to_datum_mm
+    H = g.centre_height
     rho = np.hypot(points[:, 0], H - points[:, 1])
     polar = np.arctan2(points[:, 0], H - points[:, 1])
     radius = g.pinion_tip_radius(j)
@@ -187,7 +187,7 @@ def _corner_gap(g: RackPinionGeometry, j: int, k: int, travel: float) -> float:
     """How far rack tooth k's drive corner lies outside tooth j's tip circle at ``travel`` (mm)."""
     h_left = g.rack_corner_heights(k)[0]
     x = k * g.pitch + travel - float(g.rack_half_width(h_left))
-    return math.hypot(x, g.centre_to_datum_mm - h_left) - g.pinion_tip_radius(j)
+    return math.hypot(x, g.centre_height - h_left) - g.pinion_tip_radius(j)
 
 
 def _stand_limit(g: RackPinionGeometry, j: int, k: int, stand: Stand) -> float:
@@ -203,13 +203,13 @@ def _stand_limit(g: RackPinionGeometry, j: int, k: int, stand: Stand) -> float:
     if clear(top):
         return top
     corner = _top_points(g, k, stand.travel_mm, top)[0]
-    polar = math.atan2(corner[0], g.centre_to_datum_mm - corner[1])
+    polar = math.atan2(corner[0], g.centre_height - corner[1])
     beta = float(g.involute_half_angle(g.pinion_tip_radius(j)))
     centre = (j + 0.5) * g.angular_pitch
     swept = centre + stand.start_rad - beta <= polar < centre + stand.end_rad + beta
     if abs(_corner_gap(g, j, k, stand.travel_mm)) <= ON_CIRCLE_MM and swept:
         return tangent_top_height(g, corner, k, stand.travel_mm)
-    lo, hi = g.rolling_line_height, top
+    lo, hi = g.made_rolling_line_height, top
     if not clear(lo):
         return math.nan
     for _ in range(HEIGHT_STEPS):

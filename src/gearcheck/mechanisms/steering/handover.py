@@ -90,7 +90,7 @@ def flank_pairs(g: RackPinionGeometry, profile: np.ndarray, rack_points: np.ndar
         k = j + 1 if side > 0 else j
         if not g.rack_first_tooth <= k <= g.rack_last_tooth:
             continue
-        corner = g.pinion_tip_corner(j, 0.0, side) - np.array([0.0, g.centre_to_datum_mm])
+        corner = g.pinion_tip_corner(j, 0.0, side) - np.array([0.0, g.centre_height])
         flank = fit_involute(flank_chain(profile, corner, side, g.form_radius), side)
         bl, br, tr, tl = g.rack_tooth_polygon(k, 0.0)
         root, top = (bl, tl) if side > 0 else (br, tr)

@@ -58,7 +58,7 @@ def _active(g: RackPinionGeometry, j: int, y_top: float, phis: np.ndarray) -> np
     if ("push_beta_max",) not in g._cache:
         g._cache[("push_beta_max",)] = float(g.involute_half_angle(g.form_radius))
     beta_max = g._cache[("push_beta_max",)]
-    lowest = g.centre_to_datum_mm - g.pinion_tip_radius(j) * np.cos(np.clip(theta - beta_max, 0.0, math.pi))
+    lowest = g.centre_height - g.pinion_tip_radius(j) * np.cos(np.clip(theta - beta_max, 0.0, math.pi))
     return lowest <= y_top + 1e-6
 
 
@@ -346,7 +346,7 @@ def all_intervals(g: RackPinionGeometry, phis, only: tuple[int, int] | None = No
             pairs += [(j, k) for k in ks]
             continue
         ang = gam[None, :] + g.pinion_tooth_angle(j, phis[idx])[:, None]
-        py = g.centre_to_datum_mm - rho * np.cos(ang)
+        py = g.centre_height - rho * np.cos(ang)
         y_min, y_max = py.min(axis=1), py.max(axis=1)
         overlaps = [(y_min <= c[5]) & (y_max >= c[4]) if w else np.zeros(idx.size, bool)
                     for c, w in zip(chains, wanted, strict=True)]
@@ -519,16 +519,16 @@ def towing_grid(max_angle_deg: float, step_deg: float = ANGLE_STEP_DEG, extra_de
 
 
 def analyse_towing(g: RackPinionGeometry, max_angle_deg: float, step_deg: float = ANGLE_STEP_DEG,
-                   extra_deg=CHECK_ANGLES_DEG) -> Towing:
+                   extra_deg=CHECK_ANGLES_DEG, travel_start: float = 0.0) -> Towing:
     """Forward and return towing swings of the push model, with the disengage angle (from it
     on the rack never moves again), how long the last pushing tooth still touches the standing
     rack (zero-clearance grazing), and the re-engage angle (the return swing picks the rack
-    up), each refined by bisection between grid angles."""
+    up), each refined by bisection between grid angles. ``travel_start``: the rack's travel at
+    angle 0 (0: rack tooth 0 centred, the tight mesh as designed)."""
     phis = towing_grid(max_angle_deg, step_deg, extra_deg)
     # every interval once on the grid: left flanks push the forward swing, right flanks the return
     pairs, (full_lo, full_hi), (left_lo, left_hi), (right_lo, right_hi) = all_intervals(g, phis)
-    # angle 0: tight mesh, rack tooth 0 centred
-    fwd = sweep(g, phis, 0.0, +1, (pairs, left_lo, left_hi, full_lo, full_hi))
+    fwd = sweep(g, phis, travel_start, +1, (pairs, left_lo, left_hi, full_lo, full_hi))
     end = float(fwd.travel_mm[-1])
     moving_late = end - np.interp(phis[-1] - math.radians(1.0), phis, fwd.travel_mm) > TRAVEL_TOL_MM
     dis = graze = math.nan
