@@ -43,9 +43,10 @@ lint: $(STAMP)
 	$(VENV)/bin/ruff check src bench
 	$(VENV)/bin/mypy
 
-# The three shipped tolerance studies at their default sizes (a few minutes): out/study_NAME/
+# The shipped tolerance studies at their default sizes (a few minutes): out/study_NAME/
 studies: $(STAMP)
 	$(PY) -m gearcheck study differential_tolerances --out out/study_differential_tolerances
+	$(PY) -m gearcheck study differential_mounting --out out/study_differential_mounting
 	$(PY) -m gearcheck study track_wear --out out/study_track_wear
 	$(PY) -m gearcheck study steering_tolerances --out out/study_steering_tolerances
 

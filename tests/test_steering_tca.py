@@ -132,3 +132,33 @@ def test_under_a_tilt_the_near_face_edge_bears(geometry, tilt):
     assert entry["power"]["continuous_drive_end_deg"] == edge["power"]["continuous_drive_end_deg"]
     assert entry["power"]["te_departs_deg"] == pytest.approx(edge["power"]["te_departs_deg"], abs=1e-9)
 
+
+
+def test_the_api_returns_each_mechanisms_tca_as_arrays():
+    """``Design.tca()`` beyond the bevel pair: the steering's TE curves (flat through the continuous
+    drive, as the summary's figures say), the track's and the roller chain's polygon effect (the
+    speed's ripple the closed forms give)."""
+    import math
+
+    import numpy as np
+
+    import gearcheck
+    from gearcheck.geometry import roller_chain as rcg
+    from gearcheck.geometry import track_chain as tcg
+
+    from gearcheck.geometry.rack_pinion_contact import whole_drive
+
+    design = gearcheck.load("templates/nose_wheel_steering.toml")
+    s = design.tca()
+    conj = s.towing.phi_rad <= whole_drive(an.geometry_from_params(design.params))[0].angle_rad
+    assert conj.sum() > 100 and np.ptp(s.towing.te_mm[conj]) <= 1e-9 < np.ptp(s.towing.te_mm)
+    assert s.towing.te_mm[-1] == s.summary["towing"]["te_at_disengage_mm"]
+    assert s.power.te_mm[-1] == pytest.approx(s.summary["power"]["te_at_stroke_end_mm"], abs=1e-12)
+    t = gearcheck.load("templates/eod_track_drive.toml")
+    p = t.tca()
+    assert isinstance(p, tcg.PolygonEffect)
+    assert p.ripple == pytest.approx(1 - math.cos(2 * math.pi / t.params.sprocket.teeth), abs=1e-6)
+    c = gearcheck.load("templates/roller_chain_12B_z21.toml")
+    got = c.tca()
+    z = c.params.sprocket.teeth
+    assert 1 - got["speed"].min() / got["speed"].max() == pytest.approx(rcg.speed_ripple(z), abs=1e-9)

@@ -203,8 +203,9 @@ class Mechanism(ABC):
     def study_row(self, params: Any, level: str) -> dict[str, float]:
         """One variant's figures for a study (numpy only, no CAD, no mesh): at level
         "analytical" the analytical model (default: every numeric ``calc`` figure), at level
-        "exact" the exact model (default: none). Keys are plain names; the study prefixes the
-        level."""
+        "exact" the exact model (default: none), at level "contact" the tooth contact analysis
+        (default: none; run only for a study naming one of its figures). Keys are plain names;
+        the study prefixes the level."""
         if level == "analytical":
             return {f.key: float(f.value) for f in self.analyse(params)
                     if isinstance(f.value, (int, float)) and not isinstance(f.value, bool)}

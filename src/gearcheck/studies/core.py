@@ -155,11 +155,16 @@ def evaluate(spec: StudySpec, base: Base, inputs: dict[str, np.ndarray], executo
     with progress("study: exact model", len(exact_idx), "variant") as bar:
         second = run_level(base, "exact", inputs, exact_idx, executor, bar.update)
     cols |= _prefixed("exact", _scatter(n, exact_idx, second.columns))
-    cols |= {k: np.full(n, math.nan) for k in figures if k not in cols}
     t2 = time.perf_counter()
+    if any(k.startswith("contact.") for k in figures):  # tooth contact analysis: only when a study names it
+        with progress("study: tooth contact analysis", len(exact_idx), "variant") as bar:
+            third = run_level(base, "contact", inputs, exact_idx, executor, bar.update)
+        cols |= _prefixed("contact", _scatter(n, exact_idx, third.columns))
+    cols |= {k: np.full(n, math.nan) for k in figures if k not in cols}
+    t3 = time.perf_counter()
     return {"valid": valid, "rejection": rejection, "figures": cols, "exact_rows": exact_idx,
-            "timings": {"analytical_s": t1 - t0, "exact_s": t2 - t1, "analytical_variants": n,
-                        "exact_variants": int(len(exact_idx))}}
+            "timings": {"analytical_s": t1 - t0, "exact_s": t2 - t1, "contact_s": t3 - t2,
+                        "analytical_variants": n, "exact_variants": int(len(exact_idx))}}
 
 
 def worst_variants(spec: StudySpec, figures: dict[str, np.ndarray], valid: np.ndarray, k: int) -> list[int]:

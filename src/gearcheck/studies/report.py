@@ -53,7 +53,8 @@ def _plt():
 
 _UNIT_SUFFIX = {"_pct": "%", "_mm": "mm", "_deg": "°", "_arcmin": "′", "_um": "µm", "_C": "°C", "_K": "K",
                 "_mm3": "mm³"}
-_LEVEL_WORD = {"analytical": "paper's model", "exact": "exact model", "check": "check", "in": "input"}
+_LEVEL_WORD = {"analytical": "paper's model", "exact": "exact model", "contact": "tooth contact analysis",
+               "check": "check", "in": "input"}
 
 
 def label_of(key: str, labels: dict[str, str] | None = None) -> str:

@@ -28,7 +28,7 @@ import numpy as np
 log = logging.getLogger("gearcheck")
 
 # Variants per task: large enough to amortise a task's overhead, small enough to balance.
-CHUNK = {"analytical": 64, "exact": 4}
+CHUNK = {"analytical": 64, "exact": 4, "contact": 4}
 
 
 @dataclass(frozen=True)

@@ -27,9 +27,9 @@ from gearcheck.params.common import MISSING, Section, field_range
 MAX_SAMPLES = 1_000_000
 MAX_EXACT = 100_000
 MAX_CHECKS = 20
-LEVELS = ("analytical", "exact", "check")
+LEVELS = ("analytical", "exact", "contact", "check")
 # the levels whose figures a study's outputs name (``LEVEL.KEY``)
-FIGURE_LEVELS = ("analytical", "exact")
+FIGURE_LEVELS = ("analytical", "exact", "contact")
 
 FieldPath = Annotated[str, Field(pattern=r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)+$", max_length=120)]
 Text = Annotated[str, Field(min_length=1, max_length=400)]

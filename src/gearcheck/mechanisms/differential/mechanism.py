@@ -74,6 +74,11 @@ class Differential(Mechanism):
     def study_row(self, params: DifferentialParams, level: str) -> dict[str, float]:
         from gearcheck.mechanisms.differential import study
 
+        if level == "contact":
+            from gearcheck.mechanisms.differential.poses import gear_specs
+            from gearcheck.mechanisms.differential.tca import study_figures
+
+            return study_figures(params, gear_specs(params))
         return study.exact_row(params) if level == "exact" else study.analytical_row(params)
 
     def study_batch(self, params: DifferentialParams, columns: Mapping[str, Any]) -> dict[str, Any] | None:

@@ -1,9 +1,10 @@
 """The differential's figures for a study (numpy only, no mesh): the least play per side at the
 template's shim, warm, at the cold design point, over the operating range and over the storage
 range — from the paper's first-order model (analytical level, vectorised over any number of
-variants) and from the exact spherical-involute flanks (exact level), where the exact level adds
-the tooth contact analysis over the running states (TE peak to peak, the pattern's length and
-edges: :func:`gearcheck.mechanisms.differential.tca.study_figures`).
+variants) and from the exact spherical-involute flanks (exact level). The tooth contact analysis
+over the running states (TE peak to peak, the pattern's length and edges) is the "contact" level,
+run only for a study that names one of its figures
+(:func:`gearcheck.mechanisms.differential.tca.study_figures`).
 
 The same keys at both levels, so the study report sets the paper's model beside the exact one.
 Over a temperature range the least play sits at one of its ends: linear in the paper's model,
@@ -26,8 +27,6 @@ import numpy as np
 
 from gearcheck.mechanisms.differential import analysis
 from gearcheck.mechanisms.differential import temperature as tp
-from gearcheck.mechanisms.differential.poses import gear_specs
-from gearcheck.mechanisms.differential.tca import study_figures
 
 KEYS = ("warm_play_arcmin", "cold_play_arcmin", "least_play_operating_arcmin", "least_play_storage_arcmin")
 
@@ -108,7 +107,6 @@ def exact_row(params) -> dict[str, float]:
         at.update(zip(names, (float(v) for v in plays), strict=True))
     thinning = params.thinning()
     return {
-        **study_figures(params, gear_specs(params)),
         "warm_play_arcmin": at["warm"],
         "cold_play_arcmin": at["cold"],
         "least_play_operating_arcmin": min(at["operating_min"], at["operating_max"]),

@@ -43,6 +43,18 @@ class RollerChain(Mechanism):
     def assembly(self, params: ChainParams) -> Assembly:
         return chain_assembly(params)
 
+    def tca(self, params: ChainParams) -> Any:
+        """The polygon effect over two tooth pitches on the exact wrap: {"angle_rad": sprocket
+        angles, "speed": the top span's speed over ω·R} as arrays (it dips to cos(180°/z) as each
+        roller lands)."""
+        import numpy as np
+
+        from gearcheck.mechanisms.roller_chain.model import build_model
+
+        wrap = build_model(params).wrap
+        angles = np.linspace(0.0, 2.0 * wrap.cycle_rad, 241)
+        return {"angle_rad": angles, "speed": np.array([wrap.top_speed_ratio(float(a)) for a in angles])}
+
     def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
         from gearcheck.mechanisms.roller_chain.assembly import display_frames
 

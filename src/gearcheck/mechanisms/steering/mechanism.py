@@ -53,6 +53,13 @@ class Steering(Mechanism):
     def analyse(self, params: SteeringParams) -> list[Figure]:
         return _calc.calc(params)
 
+    def tca(self, params: SteeringParams) -> Any:
+        from gearcheck.mechanisms.steering import analysis as an
+        from gearcheck.mechanisms.steering.tca import steering_tca
+
+        g = an.geometry_from_params(params)
+        return steering_tca(g, an.analyse_towing(g, params.towing.max_angle_deg))
+
     def assembly(self, params: SteeringParams) -> Assembly:
         return _assembly.assembly(params)
 

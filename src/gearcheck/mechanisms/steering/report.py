@@ -151,7 +151,30 @@ def _plots(P: dict, data: SteeringSweep) -> list[Plot]:
                       ("paper theory", P["phi_S6_deg"]), ("test", P["test_continuous_deg"]),
                       ("raw FCL corner contact", plus["geom_raw_corner_contact_angle_deg"])],
              hlines=[("S6", 0.0)]),
+        *_te_plot(data),
     ]
+
+
+def _te_plot(data: SteeringSweep) -> list[Plot]:
+    """The towing swing's and the power stroke's transmission error on the exact teeth."""
+    if data.tca is None:
+        return []
+    t = data.tca
+    drive = t.summary["towing"]
+    return [Plot("Transmission error: towing swing and power stroke (exact teeth)", "pinion angle (deg)",
+                 "TE (mm of rack travel)",
+                 [Series(c.label, np.degrees(c.phi_rad).tolist(), c.te_mm.tolist())
+                  for c in (t.towing, t.back, t.power)],
+                 markers=[("towing: continuous drive ends (model)", data.model.towing_drive_deg),
+                          ("power: continuous drive ends (model)", data.model.power_drive_deg),
+                          ("towing TE leaves zero", drive["te_departs_deg"]),
+                          ("disengage (model)", data.model.disengage_deg)],
+                 hlines=[("conjugate", 0.0)],
+                 caption=("The rack's travel less the conjugate r·φ while the pinion tows it (negative: the rack "
+                          "lags), and r·φ less the travel while the rack drives the pinion. Zero through every "
+                          "hand-over of the continuous drive (the flanks are conjugate); it leaves zero where a tip "
+                          "corner or a trimmed top takes the drive, and the towed rack stands still from the "
+                          "disengage on."))]
 
 
 def _notes(P: dict, data: SteeringSweep) -> list[str]:

@@ -28,7 +28,7 @@ from gearcheck.mechanisms.steering import certified as ce
 from gearcheck.mechanisms.steering import handover as ho
 from gearcheck.mechanisms.steering import meshes as ms
 from gearcheck.mechanisms.steering.ends import EndTop, end_tops
-from gearcheck.mechanisms.steering.tca import tca_summary
+from gearcheck.mechanisms.steering.tca import SteeringTca, steering_tca
 from gearcheck.mechanisms.steering.meshes import PINION, RACK
 from gearcheck.results import SweepOutcome, WorstPose
 
@@ -122,6 +122,8 @@ class SteeringSweep:
     # scope ("anywhere", "return_swing", "past_disengage") → the exact model's clearance certified over
     # the continuous motion (:func:`.certified.summary_entry`; + direction, the − one is its mirror)
     certified: dict = field(default_factory=dict)
+    # the transmission error's curves (:class:`.tca.SteeringTca`; None when not computed)
+    tca: SteeringTca | None = None
 
     def drive(self, mode: str, direction: int) -> ho.MeshDrive:
         return self.drives[(mode, direction)]
@@ -201,7 +203,8 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     def reduce(sent: list) -> SweepOutcome:
         results = [sent[0], sent[3], sent[1], sent[2]]
         drives = _mesh_drives(g, kin, flank_pairs, results)
-        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives, tca_summary(g, tow_model))
+        return _reduce(g, kin, model, results, tol, bound, mesh_info, t_start, paper, drives,
+                       steering_tca(g, tow_model))
 
     return SweepPlan(meshes, tasks, reduce, weights, "pose", opts)
 
@@ -442,7 +445,7 @@ def _deepest_overlap(kin: Kinematics, rows: list[dict], tol: float) -> list[Wors
 
 def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results: list, tol: float, bound: float,
             mesh_info: dict, t_start: float, paper: bool = True, drives: dict | None = None,
-            tca: dict | None = None) -> SweepOutcome:
+            tca: SteeringTca | None = None) -> SweepOutcome:
     P = an.PAPER
     tow = {r["direction"]: r for r in results[:2]}
     power = {r["direction"]: r for r in results[2:]}
@@ -498,7 +501,7 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
         "contact_tolerance_mm": tol,
         "mesh_error_bound_mm": bound,
         "certified": {scope: {k: v for k, v in e.items() if k != "where"} for scope, e in certified.items()},
-        **({"tca": tca} if tca is not None else {}),
+        **({"tca": tca.summary} if tca is not None else {}),
         "minus": _stated(minus, model.moving_at_end, tol),
         "poses": speed["poses"],
         "fcl_queries": speed["fcl_queries"],
@@ -519,6 +522,6 @@ def _reduce(g: RackPinionGeometry, kin: Kinematics, model: ModelFigures, results
     ]
     worst_poses += _deepest_overlap(kin, rows, tol)
     data = SteeringSweep(rows, tow, power, curves, plus, minus, model, tol, bound, mesh_info, speed, travel_at_adams,
-                         summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius), certified)
+                         summary["continuous_drive_deg"], drives, math.degrees(tol / g.pitch_radius), certified, tca)
     timings = {k: v for k, v in speed.items() if k not in ("poses", "fcl_queries")}
     return SweepOutcome(summary, worst_poses, timings, data)

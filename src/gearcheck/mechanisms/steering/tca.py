@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -177,3 +178,46 @@ def tca_summary(g: RackPinionGeometry, tow: push.Towing) -> dict[str, dict]:
     errors = {name: mounting_te(g, max_deg, centre_error_mm=e) for name, e in CENTRE_ERRORS_MM}
     tilts = {name: mounting_te(g, max_deg, tilt_deg=t) for name, t in TILTS_DEG}
     return {"towing": towing_te(g, tow), "power": power_te(g), **errors, **tilts}
+
+
+@dataclass(frozen=True)
+class TeCurve:
+    """A TE curve: mm of rack travel (the sign of the module doc) against the pinion angle (rad)."""
+
+    label: str
+    phi_rad: np.ndarray
+    te_mm: np.ndarray
+
+
+@dataclass(frozen=True)
+class SteeringTca:
+    """The curves behind summary.json ``tca`` (``summary``): the towing swing out to the
+    disengage, the return swing, and the power stroke (to 99 % of S6's release)."""
+
+    towing: TeCurve
+    back: TeCurve
+    power: TeCurve
+    summary: dict
+
+
+def te_curves(g: RackPinionGeometry, tow: push.Towing, samples: int = 400) -> tuple[TeCurve, TeCurve, TeCurve]:
+    """The towing swing's TE out to the disengage and back from it (the push on the exact teeth;
+    beyond the disengage the rack stands and nothing drives it), and the power stroke's (the
+    closed form), against the pinion angle."""
+    r = g.pitch_radius
+    phi = tow.forward.phi_rad
+    te = exact_travels(g, phi, tow.forward.travel_mm, +1) - r * phi
+    driven = phi <= (tow.disengage_rad if math.isfinite(tow.disengage_rad) else phi[-1])
+    back_phi = tow.back.phi_rad
+    back = exact_travels(g, back_phi, tow.back.travel_mm, -1) - r * back_phi
+    travels = np.linspace(0.0, 0.99 * power_corner(g)[2], samples + 1)
+    angles = np.array([power_model_angle(g, float(t)) for t in travels])
+    held = back_phi <= (tow.disengage_rad if math.isfinite(tow.disengage_rad) else back_phi.max())
+    return (TeCurve("towing swing, out (the pinion drives)", phi[driven], te[driven]),
+            TeCurve("towing swing, back (from the disengage angle on)", back_phi[held], back[held]),
+            TeCurve("power stroke (the rack drives)", angles, r * angles - travels))
+
+
+def steering_tca(g: RackPinionGeometry, tow: push.Towing) -> SteeringTca:
+    """The TE curves and the summary's figures of a rack and pinion (the push model ``tow``)."""
+    return SteeringTca(*te_curves(g, tow), tca_summary(g, tow))

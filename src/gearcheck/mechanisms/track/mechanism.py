@@ -38,6 +38,14 @@ class TrackDrive(Mechanism):
     def assembly(self, params: TrackParams) -> Assembly:
         return track_assembly(params)
 
+    def tca(self, params: TrackParams) -> Any:
+        """The polygon effect over one engagement cycle, measured on the wrap's poses
+        (:class:`gearcheck.geometry.track_chain.PolygonEffect`: drive angles, the entry run's
+        distance from the axis and its speed over ω·R, as arrays)."""
+        from gearcheck.geometry.track_chain import polygon_effect
+
+        return polygon_effect(track_assembly(params).layout.wrap)
+
     def display_frames(self, params: Any, assembly: Assembly) -> tuple[list[Any], str]:
         from gearcheck.mechanisms.track.display import display_frames
 
