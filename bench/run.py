@@ -489,12 +489,20 @@ def certify_section() -> dict[str, Any]:
     return _section("certify", "bench_certify", "certify")
 
 
+def tca_section() -> dict[str, Any]:
+    """bench/tca.py on the current code: the tooth contact analysis's CPU seconds against its budget."""
+    return _section("tca", "bench_tca", "tca")
+
+
 def _sections(result: dict[str, Any], args: argparse.Namespace) -> None:
     """The sections beside the side-by-side figures (each written out as soon as it is done)."""
     if not (args.quick or args.skip_study):
         log("study section (current code) ...")
         result["study"] = study_section()
     if not args.quick:
+        log("tca section (current code) ...")
+        result["tca"] = tca_section()
+        write_json(args.out, result)
         log("assembly section (current code) ...")
         result["assembly"] = assembly_section()
         write_json(args.out, result)
