@@ -34,7 +34,8 @@ def bench_tca() -> dict[str, Any]:
     from gearcheck.mechanisms.steering.tca import steering_tca
 
     diff = load_template(TEMPLATES / "zhurong_differential.toml")
-    params, specs = diff.params, gear_specs(diff.params)
+    params: Any = diff.params
+    specs = gear_specs(params)
     warm = params.operating.warm_C
     pair = _cpu(lambda: dt.state_tca(params, specs, params.shim.thickness_mm, "warm", warm))
 
@@ -47,8 +48,9 @@ def bench_tca() -> dict[str, Any]:
     check = _cpu(whole_check, 2)
     contact = _cpu(lambda: dt.study_figures(params, specs))
     steer = load_template(TEMPLATES / "nose_wheel_steering.toml")
-    g = an.geometry_from_params(steer.params)
-    tow = an.analyse_towing(g, steer.params.towing.max_angle_deg)
+    steer_params: Any = steer.params
+    g = an.geometry_from_params(steer_params)
+    tow = an.analyse_towing(g, steer_params.towing.max_angle_deg)
     steering = _cpu(lambda: steering_tca(g, tow), 2)
     return {"pair_state_cpu_s": pair, "pair_state_budget_cpu_s": PAIR_BUDGET_CPU_S,
             "pair_state_meets_budget": pair <= PAIR_BUDGET_CPU_S,

@@ -162,11 +162,18 @@ def mounted_transmission_error(big: BevelGearSpec, small: BevelGearSpec, mountin
 def on_big_tooth(gear: bp.PlacedGear, turn_rad: float, point) -> tuple[float, float]:
     """(along 0 toe … 1 heel, height 0 root … 1 tip) of a world point on a gear turned by
     ``turn_rad`` from its placed pose, in its own unscaled design."""
+    _, along, height = tooth_coordinates(gear, turn_rad, point)
+    return along, height
+
+
+def tooth_coordinates(gear: bp.PlacedGear, turn_rad: float, point) -> tuple[float, float, float]:
+    """(cone distance mm, along 0 toe … 1 heel, height 0 root … 1 tip by polar angle) of a world
+    point on a gear turned by ``turn_rad`` from its placed pose, in its own unscaled design."""
     local = np.linalg.solve(gear.turned(turn_rad).pose, np.append(np.asarray(point, float), 1.0))[:3] / gear.scale
     s = gear.spec
     theta = math.atan2(math.hypot(local[0], local[1]), local[2])
     cone = float(np.linalg.norm(local)) * math.cos(theta - s.pitch_angle_rad)
-    return ((cone - s.inner_cone_distance_mm) / (s.outer_cone_distance_mm - s.inner_cone_distance_mm),
+    return (cone, (cone - s.inner_cone_distance_mm) / (s.outer_cone_distance_mm - s.inner_cone_distance_mm),
             (theta - s.root_angle_rad) / (s.face_angle_rad - s.root_angle_rad))
 
 

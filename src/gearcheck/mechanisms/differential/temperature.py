@@ -34,6 +34,7 @@ from gearcheck.geometry import bevel_play as bp
 from gearcheck.geometry.bevel import BevelGearSpec
 from gearcheck.geometry.bevel_contact import rigid_inverse
 from gearcheck.geometry.bevel_mesh import congruent, drive_poses, play_period
+from gearcheck.geometry.bevel_tca import tooth_coordinates
 from gearcheck.mechanisms.differential.poses import GearSpecs, assembly_poses, gear_specs
 from gearcheck.mechanisms.differential.thermal import BIG_GEARS, SMALL_GEARS, thermal_state
 from gearcheck.sweep.certify import Refined, rate_bound, refine_least_many
@@ -162,14 +163,7 @@ class FlankSpot:
 def flank_spot(gear: bp.PlacedGear, turn_rad: float, point) -> FlankSpot:
     """The contact point (world) in the coordinates of one gear's teeth (the big gear turned by
     ``turn_rad`` to its contact, the small gear as placed)."""
-    pose = gear.turned(turn_rad).pose
-    local = np.linalg.solve(pose, np.append(np.asarray(point, float), 1.0))[:3] / gear.scale
-    s = gear.spec
-    r = float(np.linalg.norm(local))
-    theta = math.atan2(math.hypot(local[0], local[1]), local[2])
-    cone = r * math.cos(theta - s.pitch_angle_rad)
-    return FlankSpot(cone, (cone - s.inner_cone_distance_mm) / (s.outer_cone_distance_mm - s.inner_cone_distance_mm),
-                     (theta - s.root_angle_rad) / (s.face_angle_rad - s.root_angle_rad))
+    return FlankSpot(*tooth_coordinates(gear, turn_rad, point))
 
 
 @dataclass(frozen=True)
