@@ -145,7 +145,7 @@ def mounting_te(g: RackPinionGeometry, max_angle_deg: float, centre_error_mm: fl
     :func:`towing_te` and :func:`power_te`, with the continuous drive of the bearing section,
     the backlash the return swing measures at angle 0 (its TE there less the forward swing's at the
     start), ``binds_mm``, the deepest overlap the push model leaves (0: the mesh runs free), and
-    ``fits``: whether that is within the push model's touching tolerance."""
+    ``fits``: 1 where that is within the push model's touching tolerance, else 0."""
     widths = [f * face_width_mm for f in FACE_SECTIONS] if tilt_deg else [0.0]
     errors = [centre_error_mm + w * math.sin(math.radians(tilt_deg)) for w in widths]
     geoms = [mounted(g, e) for e in errors]
@@ -166,7 +166,7 @@ def mounting_te(g: RackPinionGeometry, max_angle_deg: float, centre_error_mm: fl
     return {"centre_error_mm": centre_error_mm, "tilt_deg": tilt_deg, "sections_w_mm": widths,
             "sections_centre_error_mm": errors, "bearing_section_w_mm": widths[bearing],
             "backlash_mm": towing["return_te_at_end_mm"] - te_start,
-            "binds_mm": binds, "fits": binds <= push.TRAVEL_TOL_MM,
+            "binds_mm": binds, "fits": float(binds <= push.TRAVEL_TOL_MM),
             "towing": {**towing, "disengage_deg": math.degrees(disengage), **drive["towing"]},
             "power": {**power_te(g, sections=tuple(geoms)), **drive["power"]}}
 
