@@ -209,13 +209,15 @@ class ContactPattern:
     def marked(self) -> np.ndarray:
         return self.gap_mm <= self.compound_mm
 
-    def developed(self) -> tuple[np.ndarray, np.ndarray]:
-        """(x, y) mm of each grid point: x along the face from the toe, y up the profile (the
-        arc from the root cone at that cone distance)."""
-        cone = self.inner_mm + self.along * (self.outer_mm - self.inner_mm)
-        x = np.broadcast_to(cone - self.inner_mm, self.gap_mm.shape)
-        y = np.outer(self.height * (self.face_rad - self.root_rad), cone)
-        return x, y
+    def developed(self, along=None, height=None) -> tuple[np.ndarray, np.ndarray]:
+        """(x, y) mm on the flank developed flat: x along the face from the toe, y up the profile
+        (the arc from the root cone at that cone distance), of the points (``along`` 0 toe … 1
+        heel, ``height`` 0 root … 1 tip; broadcast), by default of each grid point."""
+        if along is None or height is None:
+            along, height = self.along[None, :], self.height[:, None]
+        cone = self.inner_mm + np.asarray(along, float) * (self.outer_mm - self.inner_mm)
+        return np.broadcast_arrays(cone - self.inner_mm, np.asarray(height, float) * (self.face_rad - self.root_rad)
+                                   * cone)  # type: ignore[return-value]
 
     def extent(self) -> dict[str, float]:
         """Where the pattern lies: its span along the face and in height (fractions), its centre

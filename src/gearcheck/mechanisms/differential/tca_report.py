@@ -48,21 +48,15 @@ def te_plots(pairs: list[PairTca]) -> list[Plot]:
     return out
 
 
-def developed(p: bt.ContactPattern, along, height) -> tuple[np.ndarray, np.ndarray]:
-    """Developed (x, y) mm of flank points given as (along 0 toe … 1 heel, height 0 root … 1 tip)."""
-    cone = p.inner_mm + np.asarray(along, float) * (p.outer_mm - p.inner_mm)
-    return cone - p.inner_mm, np.asarray(height, float) * (p.face_rad - p.root_rad) * cone
-
-
 def pattern_plot(pair: PairTca, flank: str = "drive") -> Plot:
     """The contact pattern of one flank on the developed flank, with the flank's outline, the
     form line and the contact path."""
     p = pair.patterns[flank]
     x, y = p.developed()
-    outline = developed(p, [0.0, 1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0, 0.0])
+    outline = p.developed([0.0, 1.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 1.0, 0.0])
     along = pair.te.drive_along if flank == "drive" else pair.te.coast_along
     height = pair.te.drive_height if flank == "drive" else pair.te.coast_height
-    path = developed(p, along, height)
+    path = p.developed(along, height)
     e = p.extent()
     ends = [w for w in ("toe", "heel") if e[w]]
     series = [Series("first contact at each drive angle (the contact path)", path[0].tolist(), path[1].tolist(),
@@ -70,7 +64,7 @@ def pattern_plot(pair: PairTca, flank: str = "drive") -> Plot:
               Series("flank outline (toe left, heel right, root cone below, tip cone above)", outline[0].tolist(),
                      outline[1].tolist())]
     if p.form > 0.0:
-        form = developed(p, [0.0, 1.0], [p.form, p.form])
+        form = p.developed([0.0, 1.0], [p.form, p.form])
         series.append(Series("form line (the involute starts)", form[0].tolist(), form[1].tolist()))
     compound = p.compound_mm * 1e3
     length = (e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0
