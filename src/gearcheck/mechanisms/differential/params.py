@@ -12,7 +12,7 @@ rejected before any CAD work.
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import Field, PrivateAttr, model_validator
 
@@ -296,6 +296,11 @@ class Targets(Section):
                         description="why the level is what it is (shown with the verdict)")
 
 
+def _mounting_error(description: str, limit: float = MOUNTING_ERROR_MAX_MM, unit: str = "mm") -> Any:
+    """One mounting error of ``[tca]``: 0 by default, within ±``limit``."""
+    return Field(default=0.0, ge=-limit, le=limit, description=description, json_schema_extra=_unit(unit))
+
+
 class Tca(Section):
     """Tooth contact analysis of each big/small pair (the report's TE and contact pattern): the
     marking compound, the pair's mounting errors beyond the design (E/P/G/Σ, taken on top of each
@@ -309,18 +314,14 @@ class Tca(Section):
         default=6.0, gt=0.0, le=100.0,
         description="marking compound thickness: the flank takes the mark where the gap to the mating flank is "
                     "under it", json_schema_extra=_unit("µm"))
-    offset_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
-                             description="E: offset of the small gear's axis from the big gear's, along their common "
-                                         "perpendicular", json_schema_extra=_unit("mm"))
-    small_axial_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
-                                  description="P: the small gear moved along its axis, away from the apex (+ opens "
-                                              "the mesh)", json_schema_extra=_unit("mm"))
-    big_axial_mm: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_MM, le=MOUNTING_ERROR_MAX_MM,
-                                description="G: the big gear moved along its axis, away from the apex (+ opens the "
-                                            "mesh), beyond the shim", json_schema_extra=_unit("mm"))
-    shaft_angle_deg: float = Field(default=0.0, ge=-MOUNTING_ERROR_MAX_DEG, le=MOUNTING_ERROR_MAX_DEG,
-                                   description="Σ: the shaft angle's error (+ opens it beyond 90°)",
-                                   json_schema_extra=_unit("°"))
+    offset_mm: float = _mounting_error("E: offset of the small gear's axis from the big gear's, along their common "
+                                       "perpendicular")
+    small_axial_mm: float = _mounting_error("P: the small gear moved along its axis, away from the apex (+ opens the "
+                                            "mesh)")
+    big_axial_mm: float = _mounting_error("G: the big gear moved along its axis, away from the apex (+ opens the "
+                                          "mesh), beyond the shim")
+    shaft_angle_deg: float = _mounting_error("Σ: the shaft angle's error (+ opens it beyond 90°)",
+                                             MOUNTING_ERROR_MAX_DEG, "°")
     pattern_min_length: float | None = Field(
         default=None, gt=0.0, le=1.0,
         description="least share of the face width (toe to heel) the pattern must cover at each running state")
