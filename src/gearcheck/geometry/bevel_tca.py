@@ -209,6 +209,12 @@ class ContactPattern:
     def marked(self) -> np.ndarray:
         return self.gap_mm <= self.compound_mm
 
+    @property
+    def length(self) -> float:
+        """The pattern's span along the face (share of the face width; 0: no pattern)."""
+        cols = np.flatnonzero(self.marked.any(axis=0))
+        return float(self.along[cols[-1]] - self.along[cols[0]]) if cols.size else 0.0
+
     def developed(self, along=None, height=None) -> tuple[np.ndarray, np.ndarray]:
         """(x, y) mm on the flank developed flat: x along the face from the toe, y up the profile
         (the arc from the root cone at that cone distance), of the points (``along`` 0 toe … 1

@@ -185,7 +185,7 @@ def study_figures(params, specs: GearSpecs) -> dict[str, float]:
     return {"te_pp_urad": 1e6 * float(max(max(np.ptp(p.te.drive_rad), np.ptp(p.te.coast_rad)) for p in seen.values())),
             "warm_te_pp_urad": 1e6 * float(np.ptp(pairs["warm"].te.drive_rad)),
             "cold_te_pp_urad": 1e6 * float(np.ptp(pairs["cold"].te.drive_rad)),
-            "pattern_length": min((e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0 for e in extents),
+            "pattern_length": min(p.length for pair in seen.values() for p in pair.patterns.values()),
             "pattern_reaches_tip": float(any(e["tip"] for e in extents)),
             "pattern_end_bearing": float(any(e["toe"] != e["heel"] for e in extents))}
 

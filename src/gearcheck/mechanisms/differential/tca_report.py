@@ -67,7 +67,7 @@ def pattern_plot(pair: PairTca, flank: str = "drive") -> Plot:
         form = p.developed([0.0, 1.0], [p.form, p.form])
         series.append(Series("form line (the involute starts)", form[0].tolist(), form[1].tolist()))
     compound = p.compound_mm * 1e3
-    length = (e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0
+    length = p.length
     return Plot(f"Contact pattern, big gear {flank} flank, {pair_text(pair)} ({compound:g} µm compound)",
                 "along the face from the toe (mm)", "up the flank from the root cone (mm)", series,
                 caption=(f"The flank developed flat. Coloured where the gap to the mating flank comes under "

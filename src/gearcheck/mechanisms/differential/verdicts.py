@@ -66,7 +66,7 @@ def _pattern(params, data: SweepData) -> Verdict | None:
     worst, where, parts, below = math.inf, "", [], []
     for pair in running:
         ext = {f: p.extent() for f, p in pair.patterns.items()}
-        length = min((e["along_max"] - e["along_min"]) if e["area_share"] > 0 else 0.0 for e in ext.values())
+        length = min(p.length for p in pair.patterns.values())
         state = f"{STATE_TEXT[pair.name]} {pair.temperature_C:g} °C"
         if length < worst:
             worst, where = length, state
