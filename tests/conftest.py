@@ -1,9 +1,19 @@
 import os
+import re
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+
+# A progress line on a piped stderr (cli's line progress): a stage starting, a tenth of it, its end
+PROGRESS_LINE = re.compile(r"^(building .* \.\.\.|\S.* …|  \S.*: \d+/\S+.* \(\d+ %\)|\S.*: done in [\d.]+ s)$")
+
+
+def messages(err: str) -> list[str]:
+    """stderr less its progress lines and -v's stage lines: what gearcheck said."""
+    return [line for line in err.splitlines() if line.strip() and not PROGRESS_LINE.match(line)
+            and not line.startswith("gearcheck: stage")]
 TEMPLATES = ROOT / "templates"
 
 

@@ -164,8 +164,12 @@ def test_new_lists_the_products_and_writes_a_template_to_fill_in(steps, tmp_path
     assert re.search(r'^\[\[part\]\]\nname = "pinion" +# 1 solid', text, re.M), text
     with pytest.raises(ParamError, match=r"motion"):  # to fill in: no motion yet
         gearcheck.load(out)
-    # the examples at the end name the file's own products: uncommented, the template loads
+    # the examples at the end name the file's own products; uncommented, the one thing a shape
+    # cannot tell (the ratio) is a placeholder that is refused, and once given the template loads
     out.write_text(_uncomment(text))
+    with pytest.raises(ParamError, match=r"couple.0.ratio"):
+        gearcheck.load(out)
+    out.write_text(re.sub(r'^ratio = "\?".*$', "ratio = -0.75", _uncomment(text), flags=re.M))
     design = gearcheck.load(out)
     assert [p.name for p in design.params.part] == ["pinion", "wheel"]
 

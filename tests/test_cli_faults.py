@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from conftest import ROOT, TEMPLATES
+from conftest import ROOT, TEMPLATES, messages
 
 GEARCHECK = [str(Path(sys.executable).parent / "gearcheck")]
 TRACK = TEMPLATES / "eod_track_drive.toml"
@@ -44,8 +44,7 @@ def _alive(pid: int) -> bool:
 
 
 def _messages(err: str) -> list[str]:
-    return [line for line in err.splitlines() if line.strip() and not line.startswith("building ")
-            and not line.startswith("gearcheck: stage")]
+    return messages(err)
 
 
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
@@ -196,3 +195,61 @@ def test_the_interrupt_message_imports_nothing():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=ROOT)
     assert done.stdout.split() == ["130", "[]"], done.stdout
     assert done.stderr == "gearcheck: interrupted (SIGINT): nothing written\n"
+
+
+def _wait_for(path: Path, proc: subprocess.Popen, timeout: float = 60) -> None:
+    deadline = time.monotonic() + timeout
+    while not path.exists() and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.0002)
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_a_signal_once_the_template_is_written_leaves_new_s_result_standing(tmp_path, sig):
+    """Before: a signal as `new`'s template landed gave exit 130 / 143 with "nothing written", or
+    killed the process with no line at all while the interpreter exited (6 of 6 tries). Now the
+    result stands at every delay: exit 0, "wrote …", at most the line saying the file is complete."""
+    out = tmp_path / "d.toml"
+    for delay in (0.0, 0.001, 0.003, 0.01, 0.03, 0.1):
+        out.unlink(missing_ok=True)
+        proc = subprocess.Popen([*GEARCHECK, "new", "differential", "--module", "3", "--teeth", "14/30", "--out",
+                                 str(out)], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        _wait_for(out, proc)
+        time.sleep(delay)
+        proc.send_signal(sig)
+        stdout, err = proc.communicate(timeout=60)
+        assert proc.returncode == 0, (delay, proc.returncode, err)
+        assert stdout.startswith(f"wrote {out}: "), (delay, stdout)
+        assert _messages(err) in ([], [f"gearcheck: interrupted ({signal.Signals(sig).name}) after {out} was written: "
+                                       "it is complete"]), (delay, err)
+        from gearcheck.design import load_template
+
+        assert load_template(out).mechanism == "differential"  # complete, and valid
+
+
+@pytest.mark.cad
+def test_a_signal_at_the_commit_leaves_the_folder_as_the_line_says(tmp_path):
+    """A real `build`, SIGINT as its commit begins: either the new run was swapped in (exit 0, the
+    run complete, "… was written: it is complete" if any line) or not (exit 130, the previous run
+    kept, the line says so) — never the one with the other's line or exit code."""
+    out = tmp_path / "run"
+    old = out / "old.txt"
+    out.mkdir()
+    (out / ".gearcheck-run").write_text("x")
+    old.write_text("the previous run")
+    proc, lines = _check_until(["build", str(TEMPLATES / "nose_wheel_steering.toml"), "--out", str(out)], "commit",
+                               tmp_path)
+    proc.send_signal(signal.SIGINT)
+    rest = proc.stderr.read()  # type: ignore[union-attr]
+    err = "".join(lines) + rest
+    code = proc.wait(timeout=60)
+    said = _messages(err)
+    if old.exists():
+        assert code == 130 and said == [f"gearcheck: interrupted (SIGINT): nothing written, {out} keeps its previous "
+                                        "run"], (code, err)
+    else:
+        assert code == 0 and said in ([], [f"gearcheck: interrupted (SIGINT) after {out} was written: it is "
+                                           "complete"]), (code, err)
+        from gearcheck.verify import verify_run
+
+        verify_run(out)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".run.lock", "run"]

@@ -9,6 +9,7 @@ import pytest
 
 import gearcheck
 from gearcheck import mechanism as registry
+from conftest import messages
 from spur_pair import TEMPLATE, SpurPair
 
 pytestmark = pytest.mark.cad
@@ -108,7 +109,7 @@ def test_a_plugins_error_is_exit_3_naming_the_mechanism_and_the_hook(tmp_path, c
         path.write_text(tomli_w.dumps({**TEMPLATE, "mechanism": cls.name}))
         args = [command, str(path)] + (["--out", str(tmp_path / "run"), "--jobs", "1"] if command == "check" else [])
         assert main(args) == 3
-        err = [e for e in capsys.readouterr().err.strip().splitlines() if not e.startswith("building ")]
+        err = messages(capsys.readouterr().err)
         assert len(err) == 1 and err[0].startswith(f"gearcheck: error: {line}"), err
         assert err[0].endswith("(run with -v for the traceback)")
         with caplog.at_level("INFO", logger="gearcheck"):  # -v: the traceback goes to the log (stderr)

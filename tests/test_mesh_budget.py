@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 import gearcheck
-from conftest import TEMPLATES
+from conftest import TEMPLATES, messages
 from gearcheck import pipeline, resolution
 from gearcheck.cli import main
 
@@ -47,7 +47,7 @@ def test_a_tol_over_the_budget_is_one_line_with_the_finest_that_fits(tmp_path, m
     monkeypatch.setattr(resolution, "TRIANGLE_BUDGET", 40_000)
     out = tmp_path / "run"
     assert main(["build", str(TRACK), "--tol", "0.001", "--out", str(out), "--no-cache"]) == 2
-    lines = [line for line in capsys.readouterr().err.splitlines() if not line.startswith("building ")]
+    lines = messages(capsys.readouterr().err)
     assert len(lines) == 1, lines
     err = lines[0]
     assert err.startswith("gearcheck: error: --tol = 0.001: the meshes of this design would hold about ")

@@ -9,6 +9,8 @@ template named at once."""
 
 from __future__ import annotations
 
+import json
+import re
 import tomllib
 from collections.abc import Mapping
 from typing import Any, ClassVar
@@ -61,6 +63,9 @@ def test_python_new_writes_a_template_that_loads_as_written(spur, tmp_path):
     text = out.read_text()
     assert "face_width_mm = 20.0" in text and "# 10 modules" in text  # each derived value with its note
     assert text.splitlines()[0] == "#:schema ./schema/spur_new.json"
+    # the schema it points at is there (before: the line pointed at nothing)
+    schema = json.loads((tmp_path / "schema" / "spur_new.json").read_text())
+    assert "gears" in schema["properties"]
     data = tomllib.loads(text)
     assert data["gears"]["teeth_2"] == 24 and data["backlash"]["thinning_1_mm"] == pytest.approx(0.05)
     again = load_template(out)
@@ -142,3 +147,13 @@ def test_problems_collects_then_raises():
     assert str(many.value.with_source("f.toml")).splitlines()[1] == "f.toml: a.c = 3: allowed 4"
     with Problems():  # nothing broken: nothing raised
         pass
+
+
+def test_new_writes_floats_as_a_person_would(tmp_path):
+    """Before: ``new roller_chain --chain 08A --teeth 21 --strands 2`` wrote
+    ``tooth_width_mm = 7.140000000000001``."""
+    out = tmp_path / "duplex.toml"
+    gearcheck.new("roller_chain", chain="08A", teeth=21, strands=2, out=out)
+    text = out.read_text()
+    assert "tooth_width_mm = 7.14 " in text
+    assert not re.search(r"\d\.\d*(0000000|9999999)\d", text), text

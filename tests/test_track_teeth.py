@@ -93,7 +93,7 @@ def test_even_teeth_check_exits_0_and_lists_the_verdicts(template, tmp_path):
                            "--out", str(out), "--jobs", "1"], check=False, capture_output=True, text=True, timeout=600)
     assert proc.returncode == 0, proc.stderr
     warn = [ln for ln in proc.stdout.splitlines() if ln.strip().startswith("WARN") and "tooth count" in ln]
-    assert len(warn) == 1 and len(warn[0]) <= 120 and "z = 50 even" in warn[0]  # one line, its key figure
+    assert len(warn) == 1 and "z = 50 even" in warn[0] and "…" not in warn[0]  # one whole line, its key figure
     s = json.loads((out / "summary.json").read_text())["track"]
     assert REASON in s["verdict_measured"]["odd_tooth_count"]  # the whole sentence
     assert s["verdict_levels"]["odd_tooth_count"] == "warn" and s["verdicts"]["odd_tooth_count"] == 1

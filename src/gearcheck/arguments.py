@@ -5,6 +5,7 @@ runs the commands."""
 from __future__ import annotations
 
 import argparse
+import re
 from pathlib import Path
 
 from gearcheck import __version__
@@ -22,6 +23,16 @@ def _jobs(text: str) -> int:
         raise argparse.ArgumentTypeError(f"--jobs = {text!r}: allowed a whole number ≥ 1") from None
     if value < 1:
         raise argparse.ArgumentTypeError(f"--jobs = {value}: allowed a whole number ≥ 1")
+    return value
+
+
+def _budget(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--budget = {text!r}: allowed a number of CPU seconds > 0") from None
+    if not value > 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"--budget = {text}: allowed a number of CPU seconds > 0")
     return value
 
 
@@ -116,6 +127,12 @@ def build_parser() -> argparse.ArgumentParser:
         "one fails, 2 on input no design can meet, 3 on an internal error.",
     )
     _add_cad_args(check, "check")
+    check.add_argument("--budget", type=_budget, default=None, metavar="CPU_S",
+                       help="the most CPU seconds the sweep may be predicted to take, every worker's together "
+                            "(default 3600). A sweep whose cost grows with what a template declares (an assembly: "
+                            "pairs × poses) states its predicted cost before it starts, from its own queries timed "
+                            "on a sample; over the budget it is refused in one line naming the setting and the "
+                            "value that would fit")
 
     demo = sub.add_parser("demo", formatter_class=_Formatter,
                           help="every template in templates/: figures and CAD under --out (what `make demo` runs)",
@@ -163,6 +180,9 @@ def build_parser() -> argparse.ArgumentParser:
     new.add_argument("--out", type=Path, default=None, metavar="FILE.toml",
                      help="template to write (default: MECHANISM_NUMBERS.toml here; - prints it)")
     new.add_argument("--force", action="store_true", help="replace --out if it exists")
+    # a value starting with a minus and a digit is a number (e.g. --teeth -5/20), not an option: `new`
+    # names it and its allowed range (argparse's own pattern takes only plain negative numbers)
+    new._negative_number_matcher = re.compile(r"^-\d")
 
     study = sub.add_parser(
         "study", formatter_class=_Formatter,

@@ -8,9 +8,15 @@ coloured verdicts on a terminal, plain lines when piped, the JSON of ``--json``)
 to stderr when it is a terminal, diagnostics to the ``gearcheck`` logger (``-v`` shows them).
 
 Interrupts: SIGINT and SIGTERM are caught from the first lines of this module on (its imports are
-the standard library's only; the rest is imported inside :func:`main`), so an interrupt at any
-moment unwinds through the run's transaction — its staging folder removed, the output folder as
-it was, worker processes stopped — and ends in one line and exit 130 / 143.
+the standard library's only; the rest is imported inside :func:`main`). A command that writes
+declares its outputs first (:data:`gearcheck.interrupts.outputs`); each is committed by one
+rename, signals deferred across it and the commit recorded before they are delivered. Before
+the last output is committed, an interrupt unwinds through the run's transaction (staging folder
+removed, workers stopped) and ends in one line and exit 130 / 143: ``interrupted (SIGINT):
+nothing written, out/x keeps its previous run`` (with ``--all``, the outputs already written
+named in the same line). Once every output is committed, the result stands: the normal outcome
+and exit code, and one line more: ``interrupted (SIGINT) after out/x was written: it is
+complete``. Once the command has ended, signals are ignored while the interpreter exits.
 """
 
 from __future__ import annotations
@@ -27,14 +33,34 @@ class Interrupted(BaseException):
         self.signum = signum
 
 
-_received: list[int] = []
+_received: list[int] = []  # the interrupt that unwinds the command (or came once it had ended)
+_after: list[int] = []  # an interrupt that came once every output was committed: the result stands
+_said: list[bool] = []  # the line for _after is written
+_ended: list[bool] = []  # the command has returned (or raised): an interrupt is only recorded
+_decided: list[int] = []  # the exit code the verdicts decided, before they are printed (a closed pipe keeps it)
 _in_main: list[bool] = []  # main() is running: an interrupt unwinds through its cleanup
 
 
+def _outputs() -> Any:
+    """The running command's outputs (:data:`gearcheck.interrupts.outputs`), None before that
+    module is loaded (nothing written yet). Imports nothing."""
+    return getattr(sys.modules.get("gearcheck.interrupts"), "outputs", None)
+
+
+def _result_stands() -> bool:
+    outputs = _outputs()
+    return outputs is not None and bool(outputs.complete())
+
+
 def _on_signal(signum: int, _frame: object) -> None:
-    if _received:  # already unwinding: let the cleanup finish
+    if _received or _after:  # already unwinding (let the cleanup finish), or already recorded
+        return
+    if _result_stands():  # every output committed: the command goes on to its end, main() says so
+        _after.append(signum)
         return
     _received.append(signum)
+    if _ended:  # the command has ended: its exit code stands
+        return
     if not _in_main:  # before main() runs (this module still importing, the console script's own lines)
         signal.signal(signal.SIGINT, signal.SIG_IGN)
         signal.signal(signal.SIGTERM, signal.SIG_IGN)
@@ -54,6 +80,24 @@ if "--multiprocessing-fork" not in sys.orig_argv:
     signal.signal(signal.SIGINT, _on_signal)
     signal.signal(signal.SIGTERM, _on_signal)
 
+
+def _at_exit() -> None:
+    """The interpreter's last Python step (registered first, run last): SIGINT and SIGTERM
+    ignored from here on — Python takes its handlers down next, and a signal then would kill the
+    process with no line and another exit code — and the line of an interrupt that came once the
+    command's outputs were committed, if main() could not write it yet."""
+    if signal.getsignal(signal.SIGINT) is _on_signal:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
+        if _after:
+            _say_after()
+
+
+if "--multiprocessing-fork" not in sys.orig_argv:
+    import atexit
+
+    atexit.register(_at_exit)
+
 try:  # after the handlers: an interrupt during start-up is one line too
     import contextlib
     import json
@@ -71,54 +115,19 @@ except BaseException:
 
 if TYPE_CHECKING:
     from gearcheck.design import Design
-    from gearcheck.pipeline import Bar, CheckRun
+    from gearcheck.pipeline import CheckRun
     from gearcheck.terminal import Checked, Screen
 
 # ------------------------------------------------------------------------------------------
 # Progress and printing
 
 
-class _Plain:
-    """Progress where stderr is not a terminal: no bars, one line when a template starts; with
-    ``tenths`` (a study, minutes long), a line per stage and per tenth of its work too."""
+def _display(tenths: bool = False, patient: bool = False) -> Any:
+    """The progress display on stderr (:func:`gearcheck.terminal.display`; ``patient``: piped, a
+    stage's lines begin once it has run a few seconds)."""
+    from gearcheck.terminal import PIPED_PATIENCE_S, display
 
-    def __init__(self, tenths: bool = False) -> None:
-        self.tenths = tenths
-
-    def __enter__(self) -> _Plain:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        return None
-
-    def wait(self, desc: str) -> None:
-        print(f"{desc} ...", file=sys.stderr)
-
-    def __call__(self, desc: str, total: int | None = None, unit: str = "") -> contextlib.AbstractContextManager[Bar]:
-        from gearcheck.notebook import line_progress
-        from gearcheck.pipeline import no_progress
-
-        return line_progress(desc, total, unit, sys.stderr) if self.tenths else no_progress(desc, total, unit)
-
-
-def _display(tenths: bool = False) -> Any:
-    """Progress bars on stderr when it is a terminal, else a line per template (``tenths``: and a
-    line per stage and per tenth of its work)."""
-    from gearcheck.terminal import Bars
-
-    return Bars() if sys.stderr.isatty() else _Plain(tenths)
-
-
-class _StderrHandler(logging.StreamHandler):
-    """Logs to whatever sys.stderr is now (above the progress bars while they show)."""
-
-    @property
-    def stream(self) -> Any:
-        return sys.stderr
-
-    @stream.setter
-    def stream(self, _value: Any) -> None:
-        pass
+    return display(tenths, PIPED_PATIENCE_S if patient else 0.0)
 
 
 def _screen() -> Screen:
@@ -195,23 +204,35 @@ def _out_folder(args, design: Design) -> Path:
 
 def _prepared_folders(args, designs: list[Design]) -> list[Path]:
     """Every output folder's name and parent checked (the parent created, writable) before any
-    CAD work starts; each folder itself is written as one transaction later."""
+    CAD work starts, and declared as the command's outputs; each folder itself is written as
+    one transaction later."""
     from gearcheck.output import check_out_target
 
     folders = [_out_folder(args, d) for d in designs]
     for folder in folders:
         check_out_target(folder)
+    _declare(folders)
     return folders
 
 
+def _declare(paths: list[Path], noun: str = "run") -> None:
+    """The command writes ``paths`` (run folders, or files for another ``noun``): what an
+    interrupt's line names, and when the command's result stands (every one committed)."""
+    from gearcheck.interrupts import outputs
+    from gearcheck.output import RUN_MARKER
+
+    outputs.expect(paths, noun, RUN_MARKER if noun == "run" else None)
+
+
 def _check_one(design: Design, folder: Path, tol_mm: float | None, jobs: int | None,
-               overrides: list[str] | tuple = (), extra_files: dict | None = None) -> CheckRun:
+               overrides: list[str] | tuple = (), extra_files: dict | None = None,
+               budget_cpu_s: float | None = None) -> CheckRun:
     from gearcheck import pipeline
 
-    with _display() as bars:
+    with _display(tenths=True, patient=True) as bars:  # piped: never quiet for long
         bars.wait(f"building {design.name} ({design.mechanism})")
         return pipeline.check(design, folder, tol_mm=tol_mm, jobs=jobs, progress=bars, overrides=overrides,
-                              extra_files=extra_files)
+                              extra_files=extra_files, budget_cpu_s=budget_cpu_s)
 
 
 def _show_check(run: CheckRun | Checked, *extra: str) -> None:
@@ -231,8 +252,10 @@ def _side_by_side(executor: Any, designs: list[Design], fn: Any, args_of: Any, v
     """``fn(None, *args_of(i))`` for every template, side by side (one's single-core stages overlap
     another's), in template order. The finest default mesh (the longest run) last in line: this
     process takes it at once, with every core for its sweep; the spawned workers the others."""
+    from gearcheck.interrupts import outputs
     from gearcheck.output import remove_leftovers
 
+    outputs.elsewhere = True  # the workers commit theirs: the file system says which are written
     order = sorted(range(len(designs)), key=lambda i: -float(designs[i].impl.mesh_tol_mm))
     tasks = [args_of(i) for i in order]
     try:
@@ -254,17 +277,20 @@ def cmd_check(args) -> int:
     executor = make_executor(args.jobs)
     if executor.jobs > 1 and len(designs) > 1:
         runs = _side_by_side(executor, designs, check_task,
-                             lambda i: (designs[i], folders[i], args.tol, args.overrides, args.jobs), "checking")
+                             lambda i: (designs[i], folders[i], args.tol, args.overrides, args.jobs, args.budget),
+                             "checking")
     else:
-        runs = [Checked.of(_check_one(d, f, args.tol, args.jobs, args.overrides))
+        runs = [Checked.of(_check_one(d, f, args.tol, args.jobs, args.overrides, budget_cpu_s=args.budget))
                 for d, f in zip(designs, folders, strict=True)]
+    code = 0 if all(r.json["passed"] for r in runs) else 1
+    _decided.append(code)
     for run in runs if not args.json else []:
         _show_check(run)
     if args.json:
         _print_json([r.json for r in runs], args.all)
     for run in runs if args.open else []:
         _open(run.folder / "report.html")
-    return 0 if all(r.json["passed"] for r in runs) else 1
+    return code
 
 
 def _build_task(_state: Any, design: Design, folder: Path, tol_mm: float | None,
@@ -292,7 +318,7 @@ def cmd_build(args) -> int:
     else:
         built = []
         for d, f in zip(designs, folders, strict=True):
-            with _display() as bars:
+            with _display(tenths=True, patient=True) as bars:
                 bars.wait(f"building {d.name} ({d.mechanism})")
                 built.append(_build_task(None, d, f, args.tol, args.overrides, bars))
     if args.json:
@@ -320,6 +346,7 @@ def cmd_demo(args) -> int:
     folders = [args.out / d.name for d in designs]
     for folder in folders:
         check_out_target(folder)
+    _declare(folders)
     passed = []
     for design, folder in zip(designs, folders, strict=True):
         calc = design.calc()
@@ -343,56 +370,18 @@ def cmd_demo(args) -> int:
 
 def cmd_templates(args) -> int:
     """List the shipped templates, or copy them (and the schemas they point to) into --copy DIR."""
-    import shutil
+    from gearcheck import shipped
 
-    from gearcheck.design import load_template, packaged_templates
-    from gearcheck.output import OutputError, ensure_out_dir
-    from gearcheck.schema import SCHEMA_FOLDER
-
-    shipped = sorted(packaged_templates().glob("*.toml"))
-    schemas = sorted((packaged_templates() / SCHEMA_FOLDER).glob("*.json"))
-    if args.copy is None:
-        for path in shipped:
-            design = load_template(path)
-            print(f"{path.name:32s} {design.mechanism:13s} {design.impl.title}")
-        print(f"({len(shipped)} templates in {packaged_templates()}; copy them with --copy DIR; "
-              f"their JSON Schemas: gearcheck schema MECHANISM)")
-        from gearcheck.studies.spec import load_spec, packaged_studies
-
-        studies = sorted(packaged_studies().glob("*.toml"))
-        for path in studies:
-            spec = load_spec(path)
-            print(f"{path.stem:32s} {'study':13s} {spec.title} (template {spec.template})")
-        print(f"({len(studies)} studies; run one with `gearcheck study NAME`)")
-        return 0
-    folder = ensure_out_dir(args.copy, "--copy")
-    files = sorted(packaged_templates().glob("*.step"))  # the CAD an assembly template names, beside it
-    copies = [(p, folder / p.name) for p in [*shipped, *files]] + [(p, folder / SCHEMA_FOLDER / p.name)
-                                                                   for p in schemas]
-    for path, target in copies:
-        if target.exists() and target.read_bytes() != path.read_bytes():
-            raise OutputError(target, "exists and differs from the shipped file (not overwritten)")
-    for path, target in copies:
-        target.parent.mkdir(exist_ok=True)
-        shutil.copyfile(path, target)
-    print(f"copied {len(shipped)} templates to {folder}/ (the STEP files they name beside them, their schemas to "
-          f"{folder / SCHEMA_FOLDER}/)")
+    for line in shipped.listing() if args.copy is None else [shipped.copy_to(args.copy)]:
+        print(line)
     return 0
 
 
 def cmd_schema(args) -> int:
     """The JSON Schema of a mechanism's template (by name, or of a template file's mechanism)."""
-    from gearcheck.mechanism import names
-    from gearcheck.params import ParamError
-    from gearcheck.params.common import read_toml
-    from gearcheck.schema import schema_text
+    from gearcheck.schema import schema_of
 
-    name = args.mechanism
-    if name not in names() and name.endswith(".toml"):
-        name = read_toml(Path(name)).get("mechanism")
-    if name not in names():
-        raise ParamError("MECHANISM", args.mechanism, f"allowed one of: {', '.join(names())}, or a template file")
-    sys.stdout.write(schema_text(name))
+    sys.stdout.write(schema_of(args.mechanism))
     return 0
 
 
@@ -412,6 +401,7 @@ def cmd_new(args) -> int:
         sys.stdout.write(result.toml())
         return 0
     out = args.out if args.out is not None else Path(default_name(args.mechanism, inputs))
+    _declare([out], "version")
     design = new(args.mechanism, out=out, overrides=args.overrides, force=args.force, **inputs)
     if design is None:  # a template to fill in
         from gearcheck.params import read_toml
@@ -436,6 +426,7 @@ def cmd_study(args) -> int:
     check_scheduler(args.scheduler)
     path = find_study(args.study)
     out = args.out if args.out is not None else Path("out") / f"study_{path.stem}"
+    _declare([out])
     with _display(tenths=True) as bars:
         result = study(path, samples=given["samples"], seed=given["seed"], jobs=args.jobs, scheduler=args.scheduler,
                        out=out, exact=given["exact"], check_worst=given["check_worst"], progress=bars)
@@ -479,22 +470,30 @@ def _error(text: str, code: int = 2) -> int:
 
 
 def _interrupted(signum: int) -> int:
-    """One line, exit 128 + signal: what the run folder holds now. Nothing is imported here: an
-    interrupt inside an import leaves that module half-initialised, and importing it again can
-    print C-level warnings of its own (the decimal module's libmpdec does); without the output
-    module loaded, no run folder was touched."""
-    output = sys.modules.get("gearcheck.output")
-    run_folder = getattr(output, "RunFolder", None)
-    if run_folder is not None and run_folder.written:  # the new run was swapped in before the interrupt took effect
-        what = f"{run_folder.written} holds the new run"
-    elif run_folder is not None and run_folder.abandoned:
-        what = f"{run_folder.abandoned} unchanged"
-    else:
-        what = "nothing written"
-    with contextlib.suppress(OSError):
-        sys.stderr.write(f"gearcheck: interrupted ({signal.Signals(signum).name}): {what}\n")
-        sys.stderr.flush()
+    """One line, exit 128 + signal: what the outputs hold now (those committed, and that the
+    rest keep what they held). Nothing is imported here: an interrupt inside an import leaves
+    that module half-initialised, and importing it again can print C-level warnings of its own
+    (the decimal module's libmpdec does); without the interrupts module loaded, nothing was
+    declared, nothing written."""
+    outputs = _outputs()
+    what = outputs.unwound() if outputs is not None else "nothing written"
+    _say(f"gearcheck: interrupted ({signal.Signals(signum).name}): {what}")
     return 128 + signum
+
+
+def _say(line: str) -> None:
+    with contextlib.suppress(OSError, ValueError):
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+
+
+def _say_after() -> None:
+    """The line of an interrupt that came once every output was committed, once (only main()'s
+    end and the exit call this, one after the other; the handler only records)."""
+    outputs = _outputs()
+    if _after and not _said and outputs is not None:
+        _said.append(True)
+        _say(f"gearcheck: interrupted ({signal.Signals(_after[0]).name}) {outputs.after()}")
 
 
 def _quiet_stdout() -> None:
@@ -505,31 +504,59 @@ def _quiet_stdout() -> None:
         os.dup2(devnull, sys.stdout.fileno())
 
 
-def _late_signal(signum: int, _frame: object) -> None:
-    """After the command has ended (its output flushed): an interrupt while the interpreter
-    exits is still one line and exit 128 + signal, never a traceback."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)
-    raise SystemExit(_interrupted(signum))
+def _reset() -> None:
+    """No command running: nothing received, nothing declared."""
+    for state in (_received, _after, _said, _ended, _decided):
+        state.clear()
+    outputs = _outputs()
+    if outputs is not None:
+        outputs.clear()
 
 
 def main(argv: list[str] | None = None) -> int:
     """The command line (``argv`` None: ``sys.argv``, as the console script calls it); the exit
-    code."""
+    code. Called with ``argv`` (in a process that goes on), an interrupt after it is the
+    process's own again."""
+    _reset()
     _in_main.append(True)
     try:
-        return _main(argv)
+        code = _run(argv)
+    except Interrupted as exc:  # one that came in the instant _run began to handle another error
+        code = _interrupted(exc.signum)
+    finally:
+        _in_main.pop()
+    try:
+        return _outcome(code)
+    finally:
+        if argv is not None:
+            _reset()
+
+
+def _run(argv: list[str] | None) -> int:
+    """The command's exit code, or the interrupt's (its line written) if one unwound it."""
+    try:
+        code = _main(argv)
+        _ended.append(True)  # from here an interrupt is only recorded
     except Interrupted as exc:
         return _interrupted(exc.signum)
     except BaseException:
         if _received:  # an interrupt surfaced as another error (e.g. inside an extension's import)
             return _interrupted(_received[0])
+        _ended.append(True)  # e.g. argparse's SystemExit: on its way out, not to be cut short
         raise
-    finally:
-        _in_main.pop()
-        if argv is None and signal.getsignal(signal.SIGINT) is _on_signal:
-            signal.signal(signal.SIGINT, _late_signal)
-            signal.signal(signal.SIGTERM, _late_signal)
+    return code
+
+
+def _outcome(code: int) -> int:
+    """The exit code once the command has ended: its own, and the line of an interrupt that came
+    once its outputs were committed (the result stands; one that comes later, while the process
+    exits, gets it then); 128 + signal for one that came as a command that commits nothing
+    ended (its line written now)."""
+    if _after:
+        _say_after()
+    elif _received and _ended:
+        return _interrupted(_received[0])
+    return code
 
 
 def _main(argv: list[str] | None) -> int:
@@ -537,10 +564,11 @@ def _main(argv: list[str] | None) -> int:
         with contextlib.suppress(AttributeError, ValueError):
             stream.reconfigure(errors="backslashreplace")  # type: ignore[union-attr]
     from gearcheck.arguments import build_parser
+    from gearcheck.terminal import StderrHandler
 
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[_StderrHandler()],
+    logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING, handlers=[StderrHandler()],
                         format="gearcheck: %(message)s")
     try:
         code = COMMANDS[args.command](args)
@@ -550,12 +578,25 @@ def _main(argv: list[str] | None) -> int:
         return _failed(exc, args.verbose)
 
 
+def _unwritable(exc: OSError) -> int:
+    """An output that could not be written: a file (named), or stdout (no file named). A closed
+    pipe (`gearcheck calc … | head -1`: the reader stopped reading) ends quietly, as every
+    command-line tool does, with the code the verdicts decided (a failed check's 1 stays 1)."""
+    from gearcheck.output import output_error
+
+    if exc.filename is not None:
+        return _error(str(output_error(exc, verb="access")))
+    _quiet_stdout()
+    if isinstance(exc, BrokenPipeError):
+        return _decided[-1] if _decided else 0
+    return _error(str(output_error(exc, "<stdout>")))
+
+
 def _failed(exc: Exception, verbose: bool) -> int:
     """The one line and exit code of a command that raised: 2 for bad input or an output that
     cannot be written, 3 for a worker that died or any other error of gearcheck's own (or a
     plugin's; the traceback under -v)."""
     from gearcheck.executor import WorkerError
-    from gearcheck.output import output_error
     from gearcheck.params import ParamError
 
     if isinstance(exc, ParamError):
@@ -566,10 +607,7 @@ def _failed(exc: Exception, verbose: bool) -> int:
         logging.getLogger("gearcheck").info("worker failure", exc_info=exc)
         return _error(str(exc), 3)
     if isinstance(exc, OSError):  # an output nobody could write: stdout closed or full, a path too long
-        if exc.filename is None:  # no file named: the write that failed was to stdout
-            _quiet_stdout()
-            return _error(str(output_error(exc, "<stdout>")))
-        return _error(str(output_error(exc, verb="access")))
+        return _unwritable(exc)
     from gearcheck.mechanism import HookError
 
     logging.getLogger("gearcheck").info("internal error", exc_info=exc)

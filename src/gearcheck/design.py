@@ -8,13 +8,13 @@ nor FCL; ``build``/``check``/``assembly_cad`` import them when called.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from gearcheck import mechanism as registry
+from gearcheck.names import name_problem
 from gearcheck.params import ParamError, apply_overrides, read_toml, validate
 from gearcheck.params.common import MISSING, apply_values
 
@@ -25,10 +25,6 @@ if TYPE_CHECKING:
     from gearcheck.figures import Figure
     from gearcheck.pipeline import BuildRun, CheckRun
 
-# An optional top-level `name` names the result files (else the file's stem does); either must be
-# a plain folder name: no separators, no "..", no spaces or control characters.
-NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,63}")
-NAME_RULE = "allowed 1 to 64 characters of A-Z a-z 0-9 _ . - starting with a letter, digit or _ (a folder name)"
 # The meshing tolerances a run may use (mm): --tol, or a template's top-level mesh_tol_mm.
 TOL_MIN_MM = 0.0005
 TOL_MAX_MM = 0.5
@@ -152,17 +148,20 @@ class Design:
 
     def check(self, out: str | Path | None = None, *, tol: float | None = None, jobs: int | None = None,
               executor: Executor | None = None, options: Mapping[str, Any] | None = None,
-              progress: bool | None = None) -> CheckRun:
+              progress: bool | None = None, budget: float | None = None) -> CheckRun:
         """Build, sweep and report as ``gearcheck check`` does, into ``out`` (default out/NAME).
-        ``jobs``: worker processes (default every core; 1 runs in this process). ``progress``: print
-        a line per stage and per tenth of its work (default: in a Jupyter notebook only)."""
+        ``jobs``: worker processes (default every core; 1 runs in this process). ``progress``: show
+        each stage's progress (default: in a Jupyter notebook only, as one table updated in place;
+        elsewhere a line per stage and per tenth of its work).
+        ``budget``: the most CPU seconds the sweep may be predicted to take (``--budget``)."""
         from gearcheck import pipeline
-        from gearcheck.notebook import in_notebook, line_progress
+        from gearcheck.notebook import in_notebook, line_progress, notebook_progress
 
-        show = in_notebook() if progress is None else progress
+        inside = in_notebook()
+        show = inside if progress is None else progress
+        shown = (notebook_progress() if inside else line_progress) if show else pipeline.no_progress
         return pipeline.check(self, Path(out) if out is not None else Path("out") / self.name, tol_mm=tol,
-                              jobs=jobs, executor=executor, options=options,
-                              progress=line_progress if show else pipeline.no_progress)
+                              jobs=jobs, executor=executor, options=options, progress=shown, budget_cpu_s=budget)
 
     def assembly_cad(self):
         """A named, coloured ``cadquery.Assembly`` of the parts as built (shows in ocp_vscode)."""
@@ -179,15 +178,17 @@ def _stem(path: Path) -> str:
 
 
 def _check_run_keys(data: dict, path: Path | None, source: str) -> None:
-    """The result name (top-level ``name``, else the file's stem) is a safe folder name, and a
+    """The result name (top-level ``name``, else the file's stem: it names the result files)
+    follows the rule for names (:func:`gearcheck.names.name_problem`), and a
     recorded ``mesh_tol_mm`` is a tolerance a run may use."""
     name = data.get("name")
     if name is not None:
-        if not (isinstance(name, str) and NAME_PATTERN.fullmatch(name)):
-            raise ParamError("name", name, NAME_RULE, source)
-    elif path is not None and not NAME_PATTERN.fullmatch(_stem(path)):
-        raise ParamError("name", _stem(path), f"{NAME_RULE}; the file's name names the result unless the "
-                         "template sets a top-level name = \"...\"", source)
+        why = name_problem(name)
+        if why:
+            raise ParamError("name", name, why, source)
+    elif path is not None and name_problem(_stem(path)):
+        raise ParamError("name", _stem(path), f"{name_problem(_stem(path))}; the file's name names the result "
+                         "unless the template sets a top-level name = \"...\"", source)
     tol = data.get("mesh_tol_mm")
     allowed = f"allowed {TOL_MIN_MM:g} to {TOL_MAX_MM:g} mm"
     if tol is None:

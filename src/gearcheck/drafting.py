@@ -64,11 +64,13 @@ class Draft:
     paths: tuple[str, ...] = ()
 
     def set(self, dotted: str, value: Any, note: str = "") -> None:
-        """Set ``section.key`` (a new key goes last in its section, a new section last)."""
+        """Set ``section.key`` (a new key goes last in its section, a new section last). A float
+        is kept to 12 significant digits: 0.91 · 7.85 is written 7.1435, not 7.143500000000001
+        (the design is made from the value as written)."""
         section, _, key = dotted.partition(".")
         if not key or "." in key:
             raise ValueError(f"{dotted!r}: expected section.key")
-        self.sections.setdefault(section, {})[key] = Entry(value, note)
+        self.sections.setdefault(section, {})[key] = Entry(_tidy(value), note)
 
     def get(self, dotted: str, default: Any = None) -> Any:
         section, _, key = dotted.partition(".")
@@ -129,6 +131,15 @@ class Draft:
         return "\n".join(lines) + "\n"
 
 
+def _tidy(value: Any) -> Any:
+    """A float (also in a list) to 12 significant digits; other values as they are."""
+    if isinstance(value, float) and math.isfinite(value):
+        return float(f"{value:.12g}")
+    if isinstance(value, list):
+        return [_tidy(v) for v in value]
+    return value
+
+
 def _one_line(text: str) -> str:
     return " ".join(str(text).split())
 
@@ -162,6 +173,31 @@ def positive_number(name: str, value: Any, lo: float, hi: float) -> float:
     if not (lo <= number <= hi):
         raise ParamError(f"--{name}", value, f"allowed a number from {lo:g} to {hi:g}")
     return number
+
+
+def in_field_range(model: Any, dotted: str, value: float) -> float:
+    """``value`` of the template field ``dotted`` (``section.key`` of ``model``, a Params model) if it
+    is finite and within the field's own range (its Field ge/gt/le/lt); else :class:`ParamError`
+    naming the field, the value and that range. For a ``--set`` value the derivation uses before
+    the template is validated."""
+    import operator
+
+    import annotated_types as at
+
+    from gearcheck.params.common import field_info, field_range
+
+    path = tuple(dotted.split("."))
+    info = field_info(model, path)
+    allowed = field_range(model, path) or "allowed a finite number"
+    if not math.isfinite(value):
+        raise ParamError(dotted, value, f"must be a finite number ({allowed})")
+    tests = {at.Ge: ("ge", operator.ge), at.Gt: ("gt", operator.gt), at.Le: ("le", operator.le),
+             at.Lt: ("lt", operator.lt)}
+    for meta in info.metadata if info is not None else ():
+        attr, holds = tests.get(type(meta), ("", None))
+        if holds is not None and not holds(value, float(getattr(meta, attr))):
+            raise ParamError(dotted, value, f"out of range: {allowed}")
+    return value
 
 
 def _overrides(items: Mapping[str, Any] | Sequence[str] | None) -> dict[str, Any]:
@@ -244,7 +280,30 @@ def new(mechanism: str, *, out: str | Path | None = None, overrides: Mapping[str
         raise ParamError("--out", str(path), "its folder does not exist")
     result.relative_to(path.parent)
     atomic_write_text(path, result.toml())  # an OSError: one OutputError line
+    _schema_beside(path.parent, mechanism)
     return from_data(result.data(), path) if result.complete else None
+
+
+def _schema_beside(folder: Path, mechanism: str) -> Path:
+    """The mechanism's JSON schema at ``folder/schema/MECHANISM.json``, where the template's
+    ``#:schema`` line points (an editor then completes and checks its keys); written when
+    missing or different, left alone when it is the same."""
+    from gearcheck.output import atomic_write_text, output_error
+    from gearcheck.schema import SCHEMA_FOLDER, schema_text
+
+    target = folder / SCHEMA_FOLDER / f"{mechanism}.json"
+    text = schema_text(mechanism)
+    try:
+        if target.read_text(encoding="utf-8") == text:
+            return target
+    except (OSError, UnicodeError):
+        pass
+    try:
+        target.parent.mkdir(exist_ok=True)
+    except OSError as exc:  # e.g. a file named "schema" there
+        raise output_error(exc, target.parent) from None
+    atomic_write_text(target, text)
+    return target
 
 
 def default_name(mechanism: str, inputs: Mapping[str, Any]) -> str:

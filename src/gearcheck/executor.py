@@ -428,17 +428,23 @@ class _Run:
                 self.stopped = True
 
 
+_CAPPED_SAID: set[tuple[int, int]] = set()  # (asked, cores) already said in this process
+
+
 def capped_jobs(jobs: int | None) -> int:
     """``--jobs``: at least 1, and at most the cores this process may use (more processes than
-    cores only add start-up time and memory: a larger value is lowered, with a note)."""
+    cores only add start-up time and memory: a larger value is lowered, with a note said once per
+    process however often the value is capped). The process pool and a local Dask cluster alike."""
     cores = available_cores()
     if jobs is None:
         return cores
     if int(jobs) < 1:
         raise ValueError(f"jobs must be at least 1, got {jobs}")
     if int(jobs) > cores:
-        log.warning("--jobs %d: more than the %d core%s this process may use; running %d", jobs, cores,
-                    "" if cores == 1 else "s", cores)
+        if (int(jobs), cores) not in _CAPPED_SAID:
+            _CAPPED_SAID.add((int(jobs), cores))
+            log.warning("--jobs %d: more than the %d core%s this process may use; running %d", jobs, cores,
+                        "" if cores == 1 else "s", cores)
         return cores
     return int(jobs)
 
@@ -538,9 +544,7 @@ class DaskExecutor:
     def _local_cluster(cluster_class: Any, jobs: int | None) -> Any:
         import dask
 
-        n = available_cores() if jobs is None else int(jobs)
-        if n < 1:
-            raise ValueError(f"jobs must be at least 1, got {n}")
+        n = capped_jobs(jobs)  # a worker process per core at most, as the process pool
         # worker processes: their own log handlers, at this level
         quiet = logging.WARNING if log.isEnabledFor(logging.INFO) else logging.CRITICAL + 1
         # the workers take the configuration as it is now (no HTTP routes: nothing to serve)

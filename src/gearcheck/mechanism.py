@@ -39,6 +39,7 @@ if TYPE_CHECKING:  # type names only: importing a mechanism costs neither CadQue
     from gearcheck.results import Clearance, Report, SweepOutcome, Verdict
     from gearcheck.sweep.bodies import Body, MeshData
     from gearcheck.sweep.motion import Motion
+    from gearcheck.sweep_budget import SweepCost
 
 log = logging.getLogger("gearcheck")
 
@@ -103,7 +104,9 @@ class SweepPlan:
     is the order to run the tasks in (a permutation of their indices; results still come back in
     task order): tasks that use the same meshes next to each other, so that a worker taking a run
     of them builds only those meshes' BVHs. ``first``, if given, is work of the calling process's
-    own, done while the workers start (e.g. the BVHs the reduce step will query)."""
+    own, done while the workers start (e.g. the BVHs the reduce step will query). ``cost``, if
+    given, is the sweep's predicted cost (:class:`gearcheck.sweep_budget.SweepCost`): the pipeline
+    states it before the sweep and refuses a sweep over the budget."""
 
     meshes: list[MeshData]
     tasks: list[Task]
@@ -113,6 +116,7 @@ class SweepPlan:
     options: dict = field(default_factory=dict)
     order: list[int] | None = None
     first: Callable[[], Any] | None = None
+    cost: SweepCost | None = None
 
     def __post_init__(self) -> None:
         if self.order is not None and sorted(self.order) != list(range(len(self.tasks))):

@@ -214,18 +214,131 @@ class _LineBar:
             _say(f"  {self.desc}: {self.done}/{self.total} {self.unit} ({10 * tenth} %)", self.stream)
 
 
-def line_progress(desc: str, total: int | None = None, unit: str = "", stream: Any = None) -> Any:
+class _PatientBar(_LineBar):
+    """A :class:`_LineBar` that says nothing until its stage has run ``patience_s`` seconds:
+    then the stage's line, and a line per tenth from there on."""
+
+    def __init__(self, desc: str, total: int | None, unit: str, stream: Any, patience_s: float):
+        super().__init__(desc, total, unit, stream)
+        import time
+
+        self.start, self.patience_s, self.started = time.monotonic(), patience_s, False
+
+    def speak(self) -> bool:
+        """True once the stage has run long enough to be worth lines (its first line said now)."""
+        import time
+
+        if not self.started and time.monotonic() - self.start >= self.patience_s:
+            self.started = True
+            _say(f"{self.desc} …", self.stream)
+        return self.started
+
+    def update(self, n: int = 1) -> None:
+        if self.speak():
+            super().update(n)
+        else:
+            self.done += n
+            if self.total:
+                self.tenth = min(10, (10 * self.done) // self.total)
+
+
+def line_progress(desc: str, total: int | None = None, unit: str = "", stream: Any = None,
+                  patience_s: float = 0.0) -> Any:
     """A progress factory (``pipeline.ProgressFactory``) that prints plain lines to ``stream``
     (default stdout): the stage when it starts, every tenth of its work, its time when done. What a
-    notebook cell (or a piped run's log) shows while the work goes on."""
+    notebook cell (or a piped run's log) shows while the work goes on. ``patience_s``: a stage
+    shorter than this says nothing (its lines begin once it has run that long)."""
     import contextlib
     import time
 
     @contextlib.contextmanager
     def stage() -> Any:
         start = time.monotonic()
-        _say(f"{desc} …", stream)
-        yield _LineBar(desc, total, unit, stream)
-        _say(f"{desc}: done in {time.monotonic() - start:.1f} s", stream)
+        bar = _PatientBar(desc, total, unit, stream, patience_s)
+        bar.speak()  # the stage's first line now, unless it must first run patience_s
+        yield bar
+        if bar.speak():
+            _say(f"{desc}: done in {time.monotonic() - start:.1f} s", stream)
 
     return stage()
+
+
+class NotebookProgress:
+    """One progress display in a notebook cell, updated in place (not a line per step): a table
+    of the run's stages, each with its count, percentage and time. A progress factory
+    (``pipeline.ProgressFactory``) for ``Design.check()`` in Jupyter; where IPython's display is
+    missing it falls back to :func:`line_progress`."""
+
+    REFRESH_S = 0.25  # at most this often between two redraws (and at every stage's end)
+
+    def __init__(self) -> None:
+        self.stages: list[dict[str, Any]] = []
+        self.handle: Any = None
+        self.drawn = 0.0
+
+    def html(self) -> str:
+        rows = []
+        for st in self.stages:
+            total = st["total"]
+            count = f"{st['done']}/{total} {st['unit']}".strip() if total else (f"{st['done']}" if st["done"] else "")
+            pct = f"{min(100, 100 * st['done'] // total)} %" if total else ""
+            state = f"done in {st['seconds']:.1f} s" if st["seconds"] is not None else "…"
+            rows.append(f"<tr><td>{_esc(st['desc'])}</td><td>{_esc(count)}</td><td>{pct}</td><td>{state}</td></tr>")
+        return ("<table class='gearcheck-progress'><tr><th>stage</th><th>done</th><th></th><th>time</th></tr>"
+                + "".join(rows) + "</table>")
+
+    def draw(self, force: bool = False) -> None:
+        import time
+
+        now = time.monotonic()
+        if not force and now - self.drawn < self.REFRESH_S:
+            return
+        self.drawn = now
+        from IPython.display import HTML, display
+
+        if self.handle is None:
+            self.handle = display(HTML(self.html()), display_id=True)
+        else:
+            self.handle.update(HTML(self.html()))
+
+    def __call__(self, desc: str, total: int | None = None, unit: str = "") -> Any:
+        import contextlib
+        import time
+
+        board = self
+
+        class _Bar:
+            def __init__(self, stage: dict[str, Any]):
+                self.stage = stage
+
+            def update(self, n: int = 1) -> None:
+                self.stage["done"] += n
+                board.draw()
+
+        @contextlib.contextmanager
+        def stage() -> Any:
+            start = time.monotonic()
+            entry: dict[str, Any] = {"desc": desc, "total": total, "unit": unit, "done": 0, "seconds": None}
+            self.stages.append(entry)
+            self.draw(force=True)
+            yield _Bar(entry)
+            entry["seconds"] = time.monotonic() - start
+            self.draw(force=True)
+
+        return stage()
+
+
+def _esc(text: str) -> str:
+    import html
+
+    return html.escape(str(text))
+
+
+def notebook_progress() -> Any:
+    """The progress factory for a notebook: one display updated in place when IPython can show
+    it, else a line per stage and per tenth (:func:`line_progress`)."""
+    try:
+        import IPython.display  # noqa: F401
+    except ImportError:
+        return line_progress
+    return NotebookProgress()

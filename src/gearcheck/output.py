@@ -11,6 +11,11 @@ the new complete run, never a mix, whatever fails or whoever interrupts.
   the target left as it was.
 - :func:`atomic_write_bytes` / :func:`atomic_write_text`: one file, temp file then rename (used
   inside the staging folder, and for single files such as bench/fuzz reports).
+- A commit — a run folder's swap, or the rename of a file that is one of the command's declared
+  outputs (:data:`gearcheck.interrupts.outputs`, e.g. ``gearcheck new``'s template) — runs with
+  SIGINT / SIGTERM deferred, and records itself there before they are delivered: an interrupt
+  comes before the commit (nothing of it written) or after it (the output complete and known
+  to be), never in between.
 """
 
 from __future__ import annotations
@@ -28,7 +33,7 @@ from collections.abc import Callable
 from pathlib import Path
 from types import TracebackType
 
-from gearcheck.interrupts import DeferredSignals
+from gearcheck.interrupts import DeferredSignals, outputs
 from gearcheck.params import ParamError
 
 log = logging.getLogger("gearcheck")
@@ -155,8 +160,14 @@ def replace_atomically(path: Path, data: bytes, check: Callable[[Path], None] | 
             os.fsync(fh.fileno())
         if check is not None:
             check(tmp)
-        os.replace(tmp, path)
-        tmp = None
+        if outputs.declares(path):  # the command's output: its commit
+            with DeferredSignals():
+                os.replace(tmp, path)
+                tmp = None
+                outputs.committed(path)
+        else:
+            os.replace(tmp, path)
+            tmp = None
     finally:
         if tmp is not None:
             with contextlib.suppress(OSError):
@@ -306,32 +317,47 @@ class RunFolder:
 
     def commit(self) -> Path:
         """Swap the staging folder in; the old run (if any) is deleted after the swap. An
-        interrupt during the swap takes effect once it is done (the target holds the new run);
-        one while the old run is being deleted leaves the new run, and the old one is deleted
-        on the way out."""
+        interrupt during the swap takes effect once it is done and recorded (the target holds
+        the new run, :data:`gearcheck.interrupts.outputs` knows it); one while the old run is
+        being deleted leaves the new run, and the old one is deleted on the way out."""
         log.info("stage commit: %s", self.shown)
         try:
             (self.staging / RUN_MARKER).write_text(f"gearcheck run folder {self.name}\n", encoding="utf-8")
             with DeferredSignals():
-                if not self.target.exists():
-                    os.rename(self.staging, self.target)
-                    old = None
-                elif _exchange(self.staging, self.target):
-                    old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
-                    os.rename(self.staging, old)  # now holds the previous run: named as what it is
-                else:
-                    old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
-                    os.rename(self.target, old)  # a crash here is completed by the next run (_recover)
-                    os.rename(self.staging, self.target)
-                self._staging, self._old = None, old
+                self._swap()
                 self.committed = True
                 RunFolder.written, RunFolder.abandoned = self.shown, None
+                outputs.committed(self.shown)
         except OSError as exc:
             raise output_error(exc, self.target) from None
+        old = self._old
         if old is not None:
             shutil.rmtree(old, ignore_errors=True)
             self._old = None
         return self.target
+
+    def _swap(self) -> None:
+        """The staging folder in place of the target; the previous run (if any) left in
+        ``self._old``. Raises OSError with the target as it was."""
+        staging = self.staging
+        old = self.parent / f"{self._hidden(_OLD)}{os.getpid()}"
+        if not self.target.exists():
+            os.rename(staging, self.target)
+            self._staging = None
+        elif _exchange(staging, self.target):
+            self._staging, self._old = None, staging  # the new run is in: the staging name holds the old
+            with contextlib.suppress(OSError):
+                os.rename(staging, old)  # named as what it is (a kill while it is removed: _recover)
+                self._old = old
+        else:
+            os.rename(self.target, old)  # a crash here is completed by the next run (_recover)
+            try:
+                os.rename(staging, self.target)
+            except OSError:
+                with contextlib.suppress(OSError):
+                    os.rename(old, self.target)  # the previous run back
+                raise
+            self._staging, self._old = None, old
 
     # -- lock and leftovers --------------------------------------------------------------------
     def _lock(self) -> None:

@@ -268,8 +268,10 @@ def _seal(folder: Path, manifest: dict, extra: Mapping[str, str] | None, shown: 
     from gearcheck.output import OutputError, atomic_write_text
     from gearcheck.verify import RunIncomplete, listing, verify_run
 
+    from gearcheck.names import file_in
+
     for name, text in (extra or {}).items():
-        atomic_write_text(folder / name, text)
+        atomic_write_text(file_in(folder, name), text)
     manifest = {**manifest, "files": listing(folder)}
     atomic_write_text(folder / "manifest.json", json.dumps(manifest, indent=2, allow_nan=False) + "\n")
     try:
@@ -322,15 +324,46 @@ def build(design: Design, folder: Path, *, tol_mm: float | None = None,
 # Sweep
 
 
+def announce(progress: ProgressFactory, text: str) -> None:
+    """A line for whoever shows the progress (the CLI's bars or plain lines: its ``announce``),
+    before a long stage starts; a progress factory without one shows the stage's description only."""
+    said = getattr(progress, "announce", None)
+    if callable(said):
+        said(text)
+
+
+def _priced(design: Design, cost: Any, workers: int, budget: float, progress: ProgressFactory) -> str:
+    """A plan's predicted cost (:class:`gearcheck.sweep_budget.SweepCost`, or None) against the
+    budget: refused over it (:class:`ParamError`), else stated (the log; a line for the progress
+    display where it is long); the sweep's progress title."""
+    from gearcheck import sweep_budget
+
+    desc = f"sweeping {design.name}"
+    if cost is None:
+        return desc
+    text = cost.describe(workers, budget)
+    log.info("stage sweep: %s, predicted %s (measured in %.2f s)", design.name, text, cost.calibration_s)
+    refused = cost.refusal(budget, sweep_budget.SWEEP_MEMORY_GB, workers)
+    if refused is not None:
+        raise refused
+    predicted = cost.cpu_s(workers)
+    if predicted >= sweep_budget.ANNOUNCE_CPU_S:
+        announce(progress, f"sweeping {design.name}: {text}, on {workers} worker(s)")
+    return desc + (f" (predicted {predicted:.0f} CPU s)" if predicted >= 1.0 else "")
+
+
 def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, executor: Executor | None = None,
           jobs: int | None = None, options: Mapping[str, Any] | None = None,
-          progress: ProgressFactory = no_progress, mesh_plan: MeshPlan | None = None) -> CheckResult:
+          progress: ProgressFactory = no_progress, mesh_plan: MeshPlan | None = None,
+          budget_cpu_s: float | None = None) -> CheckResult:
     """Plan the mechanism's sweep on the meshed bodies, run its tasks on ``executor`` (default:
     a local pool of ``jobs`` processes, every core), reduce, check the mesh-resolution rule
     (``mesh_plan``: how the bodies were meshed; default: as they are, for the design's smallest
     clearance), and give verdicts and report content. No files; the exact B-rep confirmation
-    comes after."""
-    from gearcheck import resolution
+    comes after. A plan that predicts its cost (:mod:`gearcheck.sweep_budget`) states it before
+    the sweep starts and is refused (:class:`ParamError`, nothing run) over ``budget_cpu_s`` CPU
+    seconds (default :data:`gearcheck.sweep_budget.SWEEP_BUDGET_CPU_S`) or the memory budget."""
+    from gearcheck import resolution, sweep_budget
     from gearcheck.executor import make_executor
     from gearcheck.sweep.plan import run_plan
 
@@ -342,12 +375,16 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     executor = executor if executor is not None else make_executor(jobs)
     with calling(impl, "plan"):
         plan = impl.plan(design.params, assembly, bodies, options)
+    budget = float(sweep_budget.SWEEP_BUDGET_CPU_S if budget_cpu_s is None else budget_cpu_s)
+    workers = max(1, min(executor.jobs, len(plan.tasks)))
+    cost = plan.cost
+    desc = _priced(design, cost, workers, budget, progress)
     log.info("stage sweep: %s, %d tasks on %d worker(s)", design.name, len(plan.tasks), executor.jobs)
     t0 = time.perf_counter()
-    with progress(f"sweeping {design.name}", plan.total, plan.unit) as bar, calling(impl, "plan's sweep task"):
+    with progress(desc, plan.total, plan.unit) as bar, calling(impl, "plan's sweep task"):
         results = run_plan(executor, plan, bar.update)
-    log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs,
-             time.perf_counter() - t0)
+    wall_s = time.perf_counter() - t0
+    log.info("%s: %d sweep tasks on %d worker(s) in %.2f s", design.name, len(plan.tasks), executor.jobs, wall_s)
     with calling(impl, "plan's reduce"):
         outcome = plan.reduce(results)
     rule = resolution.assess(mesh_plan, bodies)
@@ -360,9 +397,16 @@ def sweep(design: Design, assembly: Assembly, bodies: Mapping[str, Body], *, exe
     timings.setdefault("workers", executor.jobs)
     summary = dict(outcome.summary)
     summary["mesh_resolution"] = rule.summary()
+    notes = [*report.notes, rule.describe()]
+    recorded: dict = {}
+    if cost is not None:
+        actual = timings.get("task_cpu_s")
+        actual = float(actual) if isinstance(actual, (int, float)) else None
+        recorded = cost.record(workers, budget, actual, wall_s)
+        notes.append(cost.note(workers, budget, actual))
     return CheckResult(impl.section, summary, verdicts, report.rows, report.comparisons, report.plots,
-                       [*report.notes, rule.describe()], outcome.worst_poses, timings, mesh_plan.clearance,
-                       resolution=rule, overlays=list(report.overlays))
+                       notes, outcome.worst_poses, timings, mesh_plan.clearance,
+                       resolution=rule, overlays=list(report.overlays), sweep_cost=recorded)
 
 
 def check_poses(assembly: Assembly, bodies: Mapping[str, Body]) -> None:
@@ -496,7 +540,7 @@ def _geometry(design: Design, run: BuildRun, result: CheckResult, progress: Prog
 def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: int | None = None,
           executor: Executor | None = None, options: Mapping[str, Any] | None = None,
           progress: ProgressFactory = no_progress, overrides: Sequence[str] = (),
-          extra_files: Mapping[str, str] | None = None) -> CheckRun:
+          extra_files: Mapping[str, str] | None = None, budget_cpu_s: float | None = None) -> CheckRun:
     """Build (meshes fine enough for the design's smallest clearance), sweep, confirm the worst poses on the exact B-rep
     and write report.html, summary.json and sweep.csv beside the CAD — all as one transaction
     (:class:`gearcheck.output.RunFolder`): ``folder`` ends up holding this whole run, or, if
@@ -515,7 +559,7 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
     with RunFolder(folder) as txn, picture_process() as drawing, plot_process() as plotting:
         run = _build_into(design, txn.staging, tol_mm, progress, overrides)
         result = sweep(design, run.assembly, run.bodies, executor=executor, jobs=jobs, options=options,
-                       progress=progress, mesh_plan=run.mesh_plan)
+                       progress=progress, mesh_plan=run.mesh_plan, budget_cpu_s=budget_cpu_s)
         if plotting is not None:
             plotting.draw(result.plots)
         built = _built_scene(design, run, drawing)
@@ -524,6 +568,8 @@ def check(design: Design, folder: Path, *, tol_mm: float | None = None, jobs: in
         geometry, plots = _geometry(design, run, result, progress, built, drawing, plotting)
         _, summary = write_report(design, txn.staging, result, run.manifest, overrides=overrides, geometry=geometry,
                                   plots=plots)
+        if result.sweep_cost:  # predicted against measured: timings, so here, not in summary.json
+            run.manifest = {**run.manifest, "sweep_cost": result.sweep_cost}
         run.manifest = _seal(txn.staging, run.manifest, extra_files, Path(folder))
         target = txn.commit()
     _rooted(run, target, ["manifest.json", *run.manifest["files"]])

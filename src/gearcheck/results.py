@@ -80,6 +80,11 @@ class Verdict:
                 text = head
         return text
 
+    def whole_line(self) -> str:
+        """``label: key figure [evidence]``, nothing cut (what the terminal shows, wrapped)."""
+        kind = next((e for e in EVIDENCE if self.evidence.startswith(e)), "")
+        return f"{self.label}: {self.key_figure}" + (f" [{kind}]" if kind else "")
+
     def line(self, width: int = 120, indent: int = 8) -> str:
         """``label: key figure [evidence]`` in at most ``width − indent`` characters (the terminal's
         one line per verdict): the evidence kind goes first; then the label is shortened while
@@ -309,6 +314,9 @@ class CheckResult:
     resolution: Any = None
     # patches painted on parts in the 3D view (gearcheck.scene.Overlay), from the report
     overlays: list[Any] = field(default_factory=list)
+    # the sweep's cost predicted before it and measured after (gearcheck.sweep_budget.SweepCost.record;
+    # timings: manifest.json, never summary.json); empty where the mechanism predicts none
+    sweep_cost: dict = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         names = [v.name for v in self.verdicts]

@@ -47,8 +47,8 @@ def _not_null(prop: dict) -> dict:
     """A TOML file has no null: an optional field (``float | None = None``) is a key that may be
     left out, so its schema is the non-null branch."""
     options = prop.get("anyOf")
-    if not options or {"type": "null"} not in options:
-        return prop
+    if not options or {"type": "null"} not in options:  # (a key the loader fills in when left out: no default)
+        return {k: v for k, v in prop.items() if not (k == "default" and v is None)}
     rest = [o for o in options if o != {"type": "null"}]
     out = {k: v for k, v in prop.items() if k != "anyOf"}
     if out.get("default", 0) is None:
@@ -91,7 +91,8 @@ def _ordered(node: dict) -> dict:
 def template_schema(mechanism: str) -> dict[str, Any]:
     """The JSON Schema (draft 2020-12) of a template of ``mechanism`` (a registry name)."""
     from gearcheck import mechanism as registry
-    from gearcheck.design import NAME_PATTERN, NAME_RULE, TOL_MAX_MM, TOL_MIN_MM
+    from gearcheck.design import TOL_MAX_MM, TOL_MIN_MM
+    from gearcheck.names import NAME_RULE, NAME_SCHEMA_PATTERN
 
     impl = registry.get(mechanism)
     model = impl.Params
@@ -107,7 +108,7 @@ def template_schema(mechanism: str) -> dict[str, Any]:
     sections = {k: _describe(model, k, v) for k, v in raw.get("properties", {}).items()}
     run_keys = {
         "mechanism": {"const": impl.name, "description": f"which mechanism this template describes: {impl.title}"},
-        "name": {"type": "string", "pattern": f"^{NAME_PATTERN.pattern}$",
+        "name": {"type": "string", "pattern": NAME_SCHEMA_PATTERN,
                  "description": f"result name (default: the file's name without .toml): {NAME_RULE}"},
         "mesh_tol_mm": {"type": "number", "minimum": TOL_MIN_MM, "maximum": TOL_MAX_MM,
                         "description": "chordal tolerance of the meshes, used as given (default: the mechanism's, "
@@ -142,3 +143,19 @@ def shipped_schema(mechanism: str) -> Path:
 def schema_line(mechanism: str) -> str:
     """The first line of a template in the templates folder: taplo's ``#:schema`` directive."""
     return f"#:schema ./{SCHEMA_FOLDER}/{mechanism}.json"
+
+
+def schema_of(mechanism_or_template: str) -> str:
+    """``gearcheck schema ARG``: the schema text of a mechanism named, or of a template file's
+    mechanism; ParamError (one line) for anything else."""
+    from gearcheck.mechanism import names
+    from gearcheck.params import ParamError
+    from gearcheck.params.common import read_toml
+
+    name: Any = mechanism_or_template
+    if name not in names() and name.endswith(".toml"):
+        name = read_toml(Path(name)).get("mechanism")
+    if not isinstance(name, str) or name not in names():
+        raise ParamError("MECHANISM", mechanism_or_template,
+                         f"allowed one of: {', '.join(names())}, or a template file")
+    return schema_text(name)

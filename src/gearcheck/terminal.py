@@ -14,9 +14,11 @@ from __future__ import annotations
 import argparse
 import contextlib
 import io
+import logging
 import math
 import os
 import re
+import sys
 from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,7 +28,7 @@ if TYPE_CHECKING:
     from rich.console import Console, RenderableType
 
     from gearcheck.figures import Figure
-    from gearcheck.pipeline import BuildRun, CheckRun
+    from gearcheck.pipeline import Bar, BuildRun, CheckRun
     from gearcheck.results import CheckResult
 
 UNBOUNDED = 4000  # the width of a "line" when nothing is wrapped (not a terminal)
@@ -36,7 +38,6 @@ NOTE_INDENT = 3
 MIN_WIDTH = 40  # narrower terminals are drawn at this width (the terminal wraps the rest)
 LEVEL_WORD = {"pass": "PASS", "warn": "WARN", "fail": "FAIL"}
 # Longest verdict line, on a terminal and piped (the whole sentence: report.html, summary.json)
-VERDICT_LINE = 120
 # calc's table when piped: this many columns (the notes wrap, or go under their quantity)
 CALC_WIDTH = 100
 LEVEL_STYLE = {"pass": "bold black on green", "warn": "bold black on yellow", "fail": "bold white on red"}
@@ -76,10 +77,13 @@ DESCRIPTION = """\
 gearcheck turns a parameter file (TOML template) into the design figures, CAD and an
 interference proof of a gear mechanism.
 
-Mechanisms: {mechanisms} (one template each in templates/:
+Mechanisms: {mechanisms}. One template each in templates/ (gearcheck templates --copy DIR):
   zhurong_differential.toml   bevel-gear differential, cold backlash and shims
   eod_track_drive.toml        roller-chain track sprocket, every other tooth engaging
-  nose_wheel_steering.toml    trimmed rack and pinion, continuous drive and disengage angles)
+  nose_wheel_steering.toml    trimmed rack and pinion, continuous drive and disengage angles
+  roller_chain_12B_z21.toml   ISO 606 sprocket and roller chain: engagement, polygon effect, wear
+  assembly_spur_pair.toml     your own CAD: a STEP assembly swept through declared joints
+Your own design from a few numbers: gearcheck new MECHANISM (--help lists its inputs).
 
 Examples:
   gearcheck calc templates/zhurong_differential.toml
@@ -91,10 +95,11 @@ Examples:
   gearcheck schema track > track.schema.json
   gearcheck demo --open
 
-Output: tables and coloured PASS / WARN / FAIL on a terminal, wrapped to its width (NO_COLOR:
-the same without colours); plain text when piped: one verdict per line (its key figure, at most
-120 characters; every sentence in full in report.html and summary.json), calc 100 columns wide.
-Progress bars with totals and the time left go to stderr when it is a terminal.
+Output: tables and coloured PASS / WARN / FAIL on a terminal, wrapped to its width, nothing cut
+(NO_COLOR: the same without colours); plain text when piped: one whole verdict per line (its
+claim, key figure and evidence; every sentence in full in report.html and summary.json), calc
+100 columns wide. Progress on stderr: bars with totals and the time left on a terminal; piped
+(CI, nohup, an IDE), a line per stage and per tenth of it.
 Exit codes: 0 no verdict fails (warnings included), 1 a verdict fails, 2 bad input, 3 an internal
 error (a worker process killed; -v shows the traceback), 130 / 143 interrupted.
 """
@@ -247,19 +252,29 @@ def _headline(result: CheckResult, name: str, folder: Path, screen: Screen) -> A
 
 
 def verdicts_view(result: CheckResult, name: str, folder: Path, screen: Screen) -> list[RenderableType]:
-    """The design's level, then one line per verdict: PASS / WARN / FAIL, what was checked and its
-    key figure (the shortfall where it fails or warns), within 120 columns or the terminal's width;
-    the whole sentence and its evidence are in report.html and summary.json (``verdict_measured``,
-    ``verdict_evidence``)."""
+    """The design's level, then each verdict: PASS / WARN / FAIL, what was checked, its key
+    figure (the shortfall where it fails or warns) and the evidence that decided it, whole: never
+    cut. Piped, one line per verdict (grep finds a verdict and its figure); on a terminal, wrapped
+    to its width under its badge. The whole sentence is in report.html and summary.json
+    (``verdict_measured``, ``verdict_evidence``)."""
+    from rich.padding import Padding
+    from rich.table import Table
     from rich.text import Text
 
     out: list[RenderableType] = [_headline(result, name, folder, screen)]
-    width = min(VERDICT_LINE, screen.width or VERDICT_LINE)
-    for v in result.verdicts:  # one line each: the key figure; the whole sentence is in the report
-        line = Text("  ")
-        line.append_text(badge(v.level, screen))
-        line.append(f"  {v.line(width, indent=10 if screen.color else 8)}")
-        out.append(line)
+    if screen.width is None:
+        for v in result.verdicts:
+            line = Text("  ")
+            line.append_text(badge(v.level, screen))
+            line.append(f"  {v.whole_line()}")
+            out.append(line)
+        return out
+    grid = Table.grid(padding=(0, 2))
+    grid.add_column(no_wrap=True)
+    grid.add_column(overflow="fold")
+    for v in result.verdicts:
+        grid.add_row(badge(v.level, screen), Text(v.whole_line()))
+    out.append(Padding(grid, (0, 0, 0, 2)))
     return out
 
 
@@ -425,6 +440,11 @@ class Bars:
         self._end_pending()
         self.pending = self.progress.add_task(desc, total=None, count="", eta="")
 
+    def announce(self, text: str) -> None:
+        """A line above the bars: what a long stage is about to cost (a sweep's prediction)."""
+        self._end_pending()
+        self.progress.console.print(text, markup=False, highlight=False)
+
     def _end_pending(self) -> None:
         if self.pending is not None:
             self.progress.update(self.pending, total=1, completed=1)
@@ -477,7 +497,7 @@ class Checked:
 
 
 def check_task(_state: Any, design: Any, folder: Path, tol_mm: float | None, overrides: list[str],
-               jobs: int | None) -> Checked:
+               jobs: int | None, budget_cpu_s: float | None = None) -> Checked:
     """One template's check for ``check --all`` (an executor task: templates run side by side).
     A pool's worker process may not start processes of its own, so there the sweep runs in it
     (``--jobs 1``); the calling process's template gets ``jobs``."""
@@ -486,4 +506,69 @@ def check_task(_state: Any, design: Any, folder: Path, tol_mm: float | None, ove
     from gearcheck import pipeline
 
     inner = 1 if mp.current_process().daemon else jobs
-    return Checked.of(pipeline.check(design, folder, tol_mm=tol_mm, jobs=inner, overrides=overrides))
+    return Checked.of(pipeline.check(design, folder, tol_mm=tol_mm, jobs=inner, overrides=overrides,
+                                     budget_cpu_s=budget_cpu_s))
+
+
+# ------------------------------------------------------------------------------------------
+# Progress where stderr is no terminal, and the log handler
+
+
+def _line(text: str) -> None:
+    """One line on this moment's stderr, flushed."""
+    sys.stderr.write(text + "\n")
+    sys.stderr.flush()
+
+
+class Plain:
+    """Progress where stderr is not a terminal: no bars, one line when a template starts; with
+    ``tenths`` (a study, minutes long), a line per stage and per tenth of its work too."""
+
+    def __init__(self, tenths: bool = False, patience_s: float = 0.0) -> None:
+        self.tenths, self.patience_s = tenths, patience_s
+
+    def __enter__(self) -> Plain:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def wait(self, desc: str) -> None:
+        _line(f"{desc} ...")
+
+    def announce(self, text: str) -> None:
+        """A long stage is coming (a sweep's predicted cost): its line, and lines as it goes."""
+        _line(text)
+        self.next_long = True
+
+    next_long = False
+
+    def __call__(self, desc: str, total: int | None = None, unit: str = "") -> contextlib.AbstractContextManager[Bar]:
+        from gearcheck.notebook import line_progress
+        from gearcheck.pipeline import no_progress
+
+        long, self.next_long = self.next_long, False
+        return (line_progress(desc, total, unit, sys.stderr, 0.0 if long else self.patience_s)
+                if self.tenths or long else no_progress(desc, total, unit))
+
+
+# piped, a check's stage that runs this long gets its lines (a quick one stays quiet)
+PIPED_PATIENCE_S = 3.0
+
+
+def display(tenths: bool = False, patience_s: float = 0.0) -> Any:
+    """Progress bars on stderr when it is a terminal, else a line per template (``tenths``: and a
+    line per stage and per tenth of its work, once the stage has run ``patience_s``)."""
+    return Bars() if sys.stderr.isatty() else Plain(tenths, patience_s)
+
+
+class StderrHandler(logging.StreamHandler):
+    """Logs to whatever sys.stderr is now (above the progress bars while they show)."""
+
+    @property
+    def stream(self) -> Any:
+        return sys.stderr
+
+    @stream.setter
+    def stream(self, _value: Any) -> None:
+        pass

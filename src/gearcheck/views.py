@@ -80,12 +80,13 @@ def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool, 
     """NAME.glb (always), the pictures and the 3D view (a check's report) into ``folder``.
     ``drawing``: a :class:`gearcheck.report.pictures.Drawing` already given this scene (its
     pictures are collected from it); else the pictures are drawn now."""
+    from gearcheck.names import file_in
     from gearcheck.output import atomic_write_bytes
     from gearcheck.report.glb import glb_bytes
 
     out = Geometry()
     name = f"{scene.name}.glb"
-    atomic_write_bytes(folder / name, glb_bytes(scene))
+    atomic_write_bytes(file_in(folder, name), glb_bytes(scene))
     out.files.append(name)
     if viewer:  # made while the picture process draws
         from gearcheck.report.viewer import viewer_html
@@ -103,7 +104,7 @@ def write_geometry(folder: Path, scene: Scene, *, pictures: bool, viewer: bool, 
         else:
             captions = picture_captions(scene)
             for file, data in drawn.items():
-                atomic_write_bytes(folder / file, data)
+                atomic_write_bytes(file_in(folder, file), data)
                 out.files.append(file)
                 out.pictures.append((captions.get(file, file), file, data))
     return out

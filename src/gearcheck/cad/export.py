@@ -25,6 +25,7 @@ from gearcheck.cad.bevel import volume_mm3
 from gearcheck.cad.mesh import CHORDAL_TOL_MM, TooManyTriangles, TriMesh, mesh_shape
 from gearcheck.cad.placement import Part, location
 from gearcheck.cad.step import StepWriteError, appearance, write_step
+from gearcheck.names import file_in
 from gearcheck.output import atomic_write_bytes, atomic_write_text, ensure_out_dir
 from gearcheck.params.common import to_toml
 
@@ -139,10 +140,10 @@ def export_parts(
         meshed = mesh_parts(parts, tol_mm, progress, max_triangles)
     exported: list[ExportedPart] = []
     for part, (mesh, volume) in zip(parts, meshed, strict=True):
-        stl = folder / f"{part.name}.stl"
+        stl = file_in(folder, f"{part.name}.stl")  # a name resolving outside the folder: refused
         atomic_write_bytes(stl, stl_bytes(posed(mesh, part.pose), part.name))
         exported.append(ExportedPart(part, mesh, stl, volume))
-    step = folder / f"{name}.step"
+    step = file_in(folder, f"{name}.step")
     step_data = write_step(parts, step, name, step_data)
     params_file = folder / "params.toml"
     atomic_write_text(params_file, to_toml(params_data, comment=params_comment))

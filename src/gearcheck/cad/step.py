@@ -44,9 +44,14 @@ from OCP.BRepBuilderAPI import BRepBuilderAPI_Copy
 from OCP.IFSelect import IFSelect_ReturnStatus
 from OCP.Interface import Interface_Static
 from OCP.Quantity import Quantity_Color, Quantity_TypeOfColor
-from OCP.STEPCAFControl import STEPCAFControl_Writer
+from OCP.STEPCAFControl import STEPCAFControl_Controller, STEPCAFControl_Writer
 from OCP.STEPControl import STEPControl_Reader, STEPControl_StepModelType
-from OCP.StepBasic import StepBasic_DerivedUnit, StepBasic_SiUnitAndLengthUnit, StepBasic_SiUnitAndMassUnit
+from OCP.StepBasic import (
+    StepBasic_DerivedUnit,
+    StepBasic_Product,
+    StepBasic_SiUnitAndLengthUnit,
+    StepBasic_SiUnitAndMassUnit,
+)
 from OCP.StepRepr import StepRepr_MeasureRepresentationItem, StepRepr_NextAssemblyUsageOccurrence
 from OCP.StepShape import StepShape_ShapeDefinitionRepresentation, StepShape_SolidModel
 from OCP.TCollection import TCollection_ExtendedString, TCollection_HAsciiString
@@ -207,7 +212,10 @@ def _set_header(model, file_name: str, assembly_name: str, timestamp: str) -> No
 
 @contextlib.contextmanager
 def writer_settings() -> Iterator[None]:
-    """Set :data:`WRITER_SETTINGS` for one write and put the previous values back."""
+    """Set :data:`WRITER_SETTINGS` for one write and put the previous values back. The STEP
+    controller is initialised first: before it, the settings do not exist yet (a process whose
+    first STEP work is this write would skip them all, and name its products OCCT's way)."""
+    STEPCAFControl_Controller.Init_s()
     previous = {k: Interface_Static.CVal_s(k) for k in WRITER_SETTINGS if Interface_Static.IsPresent_s(k)}
     try:
         for key in previous:
@@ -264,6 +272,43 @@ def xcaf_document(parts: Sequence[Part], assembly_name: str) -> TDocStd_Document
     return doc
 
 
+def part21_string(text: str) -> str:
+    """``text`` as an ISO 10303-21 string's contents: ASCII as it is, every run of other
+    characters as ``\\X2\\`` + four hex digits a character + ``\\X0\\`` (``\\X4\\``, eight
+    digits, beyond the basic plane)."""
+    out: list[str] = []
+    for run in re.findall(r"[\x00-\x7f]+|[^\x00-\x7f\U00010000-\U0010ffff]+|[\U00010000-\U0010ffff]+", text):
+        if run.isascii():
+            out.append(run)
+        elif ord(run[0]) <= 0xFFFF:
+            out.append("\\X2\\" + "".join(f"{ord(c):04X}" for c in run) + "\\X0\\")
+        else:
+            out.append("\\X4\\" + "".join(f"{ord(c):08X}" for c in run) + "\\X0\\")
+    return "".join(out)
+
+
+def _written_as(text: str) -> str | None:
+    """The name OCCT's model holds as ``text`` (UTF-8 bytes as Latin-1 characters), decoded; None
+    for an ASCII text or one that is not such bytes."""
+    if text.isascii():
+        return None
+    try:
+        return text.encode("latin-1").decode("utf-8")
+    except UnicodeError:
+        return None
+
+
+def _encode_names(entity) -> None:
+    """The entity's id, name and description in ISO 10303-21's encoding (see :func:`_fix_model`)."""
+    for field in ("Id", "Name", "Description"):
+        value = getattr(entity, field)() if hasattr(entity, field) else None
+        if value is None:
+            continue
+        original = _written_as(value.ToCString())
+        if original is not None:
+            getattr(entity, "Set" + field)(_hstr(part21_string(original)))
+
+
 def _entities(model) -> list:
     return [model.Value(i) for i in range(1, model.NbEntities() + 1)]
 
@@ -274,9 +319,14 @@ def _fix_model(model) -> None:
     * NEXT_ASSEMBLY_USAGE_OCCURRENCE ids come from a process-wide counter: renumber 1, 2, ….
     * The density unit is written as g³·cm² (exponents swapped in OCCT's writer): make it g·cm⁻³
       (OCCT's reader takes the value as g/cm³ either way).
+    * A name beyond ASCII (``齿轮``) reaches the model as its UTF-8 bytes taken one by one as
+      Latin-1 characters, which the file would show as ``é½¿è½®``: write it in ISO 10303-21's
+      own encoding, ``\\X2\\9F7F8F6E\\X0\\``, which every reader (OCCT's too) decodes.
     """
     k = 0
     for e in _entities(model):
+        if isinstance(e, (StepBasic_Product, StepRepr_NextAssemblyUsageOccurrence)):
+            _encode_names(e)
         if isinstance(e, StepRepr_NextAssemblyUsageOccurrence):
             k += 1
             e.SetId(_hstr(str(k)))

@@ -35,6 +35,10 @@ one, else by its *product* name. Two kinds of name are treated as no name:
 * the placeholder product name OCCT's writer gives a shape without one (``Open CASCADE STEP
   translator 7.9 2``, as ``cadquery.exporters.export`` writes it).
 
+An occurrence named beyond ASCII (``齿轮``, encoded ``\\X2\\9F7F8F6E\\X0\\`` in the file) keeps its
+name: OCCT's reader would put the occurrence's id in its place, and the id is read back as the
+name the file gives.
+
 A leaf without a name is ``solid_1``, ``solid_2``… in file order. Leaf names are made unique in
 file order: a name that occurs again gets ``#2``, ``#3``… (skipping any name the file itself
 uses, so no name the file gives is ever changed). :attr:`StepProduct.path` names every level
@@ -56,7 +60,7 @@ import contextlib
 import logging
 import os
 import re
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -246,11 +250,14 @@ def _file_unit(reader: STEPCAFControl_Reader) -> str:
     return ",".join(units) or "UNKNOWN"
 
 
-def _id_only_instances(reader: STEPCAFControl_Reader) -> frozenset[str]:
-    """Ids of the assembly occurrences with neither name nor description (OCCT names such an
-    instance by its id), less any string another occurrence uses as its name."""
+def _id_only_instances(reader: STEPCAFControl_Reader) -> dict[str, str | None]:
+    """The ids OCCT may have put in place of an assembly occurrence's name, each with the name
+    it stands for: ``None`` for an occurrence with neither name nor description (OCCT names such
+    an instance by its id), the decoded name for one whose name holds characters beyond ASCII
+    (``\\X2\\...\\X0\\`` in the file: OCCT's reader drops such a name for the id). An id that
+    another occurrence uses as its own name is left out: it is a real name there."""
     model = reader.ChangeReader().StepModel()
-    ids: set[str] = set()
+    ids: dict[str, str | None] = {}
     names: set[str] = set()
     for i in range(1, model.NbEntities() + 1):
         entity = model.Value(i)
@@ -258,14 +265,19 @@ def _id_only_instances(reader: STEPCAFControl_Reader) -> frozenset[str]:
             continue
         description = entity.Description().ToCString() if entity.HasDescription() else ""
         name = entity.Name().ToCString() if entity.Name() is not None else ""
-        if description or name:
-            names.add(description or name)
-        elif entity.Id() is not None:
-            ids.add(entity.Id().ToCString())
-    return frozenset(ids - names)
+        own = (description or name).strip()
+        if own:
+            names.add(own)
+        if entity.Id() is None:
+            continue
+        if not own:
+            ids[entity.Id().ToCString()] = None
+        elif not own.isascii():
+            ids[entity.Id().ToCString()] = own
+    return {k: v for k, v in ids.items() if k not in names or v is not None}
 
 
-def _transfer(path: Path) -> tuple[TDocStd_Document, str, frozenset[str]]:
+def _transfer(path: Path) -> tuple[TDocStd_Document, str, dict[str, str | None]]:
     """Parse and transfer the file: the XCAF document (mm), the file's unit and the ids OCCT
     used as instance names. The reader (and its STEP entity model) is released on return."""
     reader = _reader()
@@ -294,27 +306,33 @@ def _transfer(path: Path) -> tuple[TDocStd_Document, str, frozenset[str]]:
 # Walking the document
 
 
+_NO_IDS: Mapping[str, str | None] = {}
+
+
 def _label_name(label: TDF_Label) -> str:
     """The label's TDataStd_Name, "" if it has none."""
     attr = TDataStd_Name()
     return attr.Get().ToExtString() if label.FindAttribute(TDataStd_Name.GetID_s(), attr) else ""
 
 
-def _real(name: str, id_only: frozenset[str] = frozenset()) -> str | None:
-    """``name`` unless it is empty, an id OCCT put in place of a name, or OCCT's placeholder."""
+def _real(name: str, id_only: Mapping[str, str | None] = _NO_IDS) -> str | None:
+    """``name`` unless it is empty or OCCT's placeholder; an id OCCT put in place of a name is
+    the name it stands for (``None`` for an occurrence without one)."""
     name = name.strip()
-    if not name or name in id_only or _OCCT_PLACEHOLDER.fullmatch(name):
+    if name in id_only:
+        return id_only[name]
+    if not name or _OCCT_PLACEHOLDER.fullmatch(name):
         return None
     return name
 
 
-def _level_name(instance: TDF_Label | None, product: TDF_Label, id_only: frozenset[str]) -> str | None:
+def _level_name(instance: TDF_Label | None, product: TDF_Label, id_only: Mapping[str, str | None]) -> str | None:
     """A level's name: the instance's own name when it has one, else the product's."""
     own = _real(_label_name(instance), id_only) if instance is not None else None
     return own or _real(_label_name(product))
 
 
-def _leaves(doc: TDocStd_Document, id_only: frozenset[str]) -> list[_Leaf]:
+def _leaves(doc: TDocStd_Document, id_only: Mapping[str, str | None]) -> list[_Leaf]:
     """Every leaf (non-assembly) product instance reachable from the free shapes, depth first in
     file order, with its composed placement."""
     tool = XCAFDoc_DocumentTool.ShapeTool_s(doc.Main())
@@ -328,7 +346,7 @@ def _leaves(doc: TDocStd_Document, id_only: frozenset[str]) -> list[_Leaf]:
 
 
 def _walk(product: TDF_Label, instance: TDF_Label | None, location: TopLoc_Location,
-          names: tuple[str | None, ...], id_only: frozenset[str], out: list[_Leaf]) -> None:
+          names: tuple[str | None, ...], id_only: Mapping[str, str | None], out: list[_Leaf]) -> None:
     """Append the leaves under ``product`` (reached through ``instance``, None for a free
     shape) to ``out``: a component's placement is composed after its parent's (``location``)."""
     names = (*names, _level_name(instance, product, id_only))
@@ -355,6 +373,15 @@ def volume_mm3(shape: TopoDS_Shape) -> float:
     props = GProp_GProps()
     BRepGProp.VolumeProperties_s(shape, props, False, False, False)
     return float(props.Mass())
+
+
+def centroid(shape: TopoDS_Shape) -> tuple[float, float, float]:
+    """Centre of volume of ``shape`` (its solids), in the shape's frame and unit: on a gear's
+    axis whatever its tooth count (a bounding box's centre is not, for an odd count)."""
+    props = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, props, False, False, False)
+    c = props.CentreOfMass()
+    return float(c.X()), float(c.Y()), float(c.Z())
 
 
 def bounding_box(shape: TopoDS_Shape) -> BBox:

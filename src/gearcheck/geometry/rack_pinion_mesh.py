@@ -62,8 +62,8 @@ def flank_chain(profile: np.ndarray, corner, side: int, form_radius: float) -> n
         if not (rho[nxt] < rho[idx[-1]] and rho[nxt] >= form_radius - CORNER_MATCH_MM):
             break
         idx.append(nxt)
-    if len(idx) < 3:
-        raise ValueError(f"pinion flank at ({corner[0]:.3f}, {corner[1]:.3f}) has {len(idx) - 1} chord on the mesh")
+    if len(idx) < 2:
+        raise ValueError(f"pinion flank at ({corner[0]:.3f}, {corner[1]:.3f}) has no chord on the mesh")
     return profile[idx[::-1]]
 
 
@@ -108,19 +108,38 @@ class FlankInvolute:
         return u + np.pi * np.round((middle - u) / np.pi)
 
 
-def fit_involute(chain: np.ndarray, side: int, iterations: int = 30) -> FlankInvolute:
-    """The involute of the pinion's axis through the vertices of a flank ``chain`` (inner → tip
-    corner, own frame; ``side`` as :func:`flank_chain`): base radius and start angle by
-    Gauss-Newton, from the base radius the curvature of the middle three vertices gives
-    (ρ_c² = ρ² − base² on an involute)."""
-    rho, gamma = _polar(chain)
+def _seed_base(chain: np.ndarray, rho: np.ndarray) -> float:
+    """A first base radius for :func:`fit_involute`: from the curvature of the middle three vertices
+    (ρ_c² = ρ² − base² on an involute), or with two vertices (a flank the mesher draws as one
+    chord) from the chord's angle to the radius at its middle (on an involute the tangent meets the
+    radius at the pressure angle there, cos α = base/ρ)."""
+    top = float(rho.min())
+    if len(chain) < 3:
+        mid = 0.5 * (chain[0] + chain[-1])
+        chord = chain[-1] - chain[0]
+        rho_mid = float(np.linalg.norm(mid))
+        cos_a = abs(float(chord @ mid)) / (float(np.linalg.norm(chord)) * rho_mid)
+        return min(max(rho_mid * cos_a, 0.25 * top), top)
     m = len(chain) // 2
     a, b, c = chain[m - 1], chain[m], chain[m + 1]
     area2 = abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
     sides = np.linalg.norm(b - a) * np.linalg.norm(c - b) * np.linalg.norm(c - a)
     rho_c = sides / (2.0 * area2) if area2 > 0.0 else 0.0
+    return float(np.sqrt(max(rho[m] ** 2 - rho_c ** 2, 0.25 * top * top)))
+
+
+def fit_involute(chain: np.ndarray, side: int, iterations: int = 30) -> FlankInvolute:
+    """The involute of the pinion's axis through the vertices of a flank ``chain`` (inner → tip
+    corner, at least two vertices, own frame; ``side`` as :func:`flank_chain`): base radius and
+    start angle by Gauss-Newton from :func:`_seed_base`. Two vertices (a short flank, e.g. a
+    topped end tooth's just above the form circle, whose one chord sags less than the mesh's
+    tolerance) determine the involute exactly: its residual is then nil by construction, and only
+    the other flanks measure how far the mesh is from an involute."""
+    rho, gamma = _polar(chain)
+    if len(chain) < 2:
+        raise ValueError("an involute needs at least two vertices of its flank")
     top = float(rho.min())
-    base = float(np.sqrt(max(rho[m] ** 2 - rho_c ** 2, 0.25 * top * top)))
+    base = _seed_base(chain, rho)
     for _ in range(iterations):
         base = min(base, top)
         inv, dinv = _inv_roll(base, rho)

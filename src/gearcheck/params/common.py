@@ -111,16 +111,27 @@ class Section(BaseModel):
         return data
 
 
-def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:
-    """Describe the allowed range of the field at ``path`` from its Field(ge=..., le=...) metadata."""
+def field_info(model: type[BaseModel], path: tuple[str, ...]) -> Any:
+    """The FieldInfo at ``path``, through sections, optional sections and lists of sections
+    (an item by its index); None where the path leads to no field."""
     current: Any = model
     info = None
     for name in path:
+        current = _unwrap(current)
         fields = getattr(current, "model_fields", None)
-        if not fields or name not in fields:
-            return ""
-        info = fields[name]
-        current = info.annotation
+        if fields and name in fields:
+            info = fields[name]
+            current = info.annotation
+        elif name.isdigit() and typing.get_origin(current) is list:
+            current = typing.get_args(current)[0]
+        else:
+            return None
+    return info
+
+
+def field_range(model: type[BaseModel], path: tuple[str, ...]) -> str:
+    """Describe the allowed range of the field at ``path`` from its Field(ge=..., le=...) metadata."""
+    info = field_info(model, path)
     if info is None:
         return ""
     lo: Any = None
@@ -224,13 +235,15 @@ def _value_problem(model: type[BaseModel], loc: tuple[str, ...], kind: str, valu
         # a TOML integer beyond any float: pydantic calls it the wrong type
         return f"out of range (larger than any float): {allowed}" if allowed else "out of range (larger than any float)"
     if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
-        return f"out of range: {allowed}"
+        return f"out of range: {allowed}" if allowed else f"out of range: {msg.lower()}"
     if kind == "finite_number":
         return f"must be a finite number ({allowed})" if allowed else "must be a finite number"
     if kind.endswith(("_type", "_parsing")):
         wanted = _field_type(model, loc)
         extra = f"; {allowed}" if allowed else (f"; allowed type: {wanted}" if wanted else "")
         return f"wrong type: {msg.lower()}{extra}"
+    if kind == "value_error":  # a validator's own words, without pydantic's prefix
+        msg = msg.removeprefix("Value error, ")
     return msg + (f" ({allowed})" if allowed else "")
 
 
@@ -289,10 +302,34 @@ def _set_path(node: dict, path: tuple[str, ...], value: Any) -> None:
 def apply_overrides(data: dict, overrides: list[str]) -> dict:
     """Return a copy of ``data`` with each ``--set`` override applied (type checks come later)."""
     out = copy.deepcopy(data)
+    paths = []
     for text in overrides:
         path, value = parse_override(text)
         _set_path(out, path, value)
+        paths.append(path)
+    _drop_companions(out, paths)
     return out
+
+
+def _companions(key: str) -> tuple[str, ...]:
+    """The keys whose value went with ``key``'s: a material's expansion coefficient with its name."""
+    return ("cte_per_K",) if key == "material" else (f"{key}_cte_per_K",)
+
+
+def _drop_companions(data: dict, paths: list[tuple[str, ...]]) -> None:
+    """A material's name set anew drops the coefficient the template gave with the old name
+    (unless that is set too): the new name's comes from the materials table. Without this,
+    ``--set materials.housing="grey cast iron"`` would keep aluminium's expansion."""
+    given = set(paths)
+    for path in paths:
+        parent: Any = data
+        for part in path[:-1]:
+            parent = parent.get(part) if isinstance(parent, dict) else None
+        if not isinstance(parent, dict):
+            continue
+        for companion in _companions(path[-1]):
+            if companion in parent and (*path[:-1], companion) not in given:
+                del parent[companion]
 
 
 def apply_values(data: dict, values: dict[str, Any]) -> dict:
@@ -308,6 +345,7 @@ def apply_values(data: dict, values: dict[str, Any]) -> dict:
             raise ParamError("overrides", key, f"key nested {len(path)} levels deep; allowed at most {MAX_NESTING}")
         _check_nesting(value, str(key), len(path))
         _set_path(out, path, copy.deepcopy(value))
+    _drop_companions(out, [tuple(p.strip() for p in str(k).split(".")) for k in values])
     return out
 
 

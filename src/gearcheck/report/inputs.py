@@ -202,7 +202,10 @@ def input_rows(design: Design, overrides: Sequence[str] = ()) -> list[InputRow]:
     override); the template value is then the file's."""
     params = design.params
     model = type(params)
-    data = design.resolved_data
+    # the values as given (a STEP path as the template writes it, never made absolute: a report
+    # leaves the user's folders out); a value the run derived (a material's coefficient from its
+    # name) from the resolved data
+    data = _Values(design.data, design.resolved_data)
     template = _template_data(design)
     named = _overridden_keys(overrides)
     notes, section_notes = template_comments(design.path) if design.path is not None else ({}, {})
@@ -234,12 +237,26 @@ def _section_model(annotation: Any) -> Any:
     return None
 
 
-def _row(model, own: tuple[str, ...], info, data: dict, template: dict | None, named: set[str],
+@dataclass(frozen=True)
+class _Values:
+    """A design's values as given (``given``: the template with its overrides) and as the run
+    resolved them (``resolved``: paths made absolute, derived values filled in)."""
+
+    given: dict
+    resolved: dict
+
+
+def _row(model, own: tuple[str, ...], info, data: _Values, template: dict | None, named: set[str],
          notes: dict[str, str], section_note: str, prefix: tuple[str, ...] = ()) -> InputRow:
-    """One field: ``own`` its path in ``model`` (its section's model), ``prefix`` the section."""
+    """One field: ``own`` its path in ``model`` (its section's model), ``prefix`` the section. A
+    row is overridden when a --set names it or its value differs from the file's; a value the
+    run derived (absent from what was given) is shown with a note saying so."""
     path = prefix + own
     key = ".".join(path)
-    present, value = _lookup(data, path)
+    given, value = _lookup(data.given, path)
+    present = given
+    if not given:
+        present, value = _lookup(data.resolved, path)
     in_file, file_value = _lookup(template, path)
     extra = info.json_schema_extra if isinstance(info.json_schema_extra, dict) else {}
     allowed = allowed_range(info)
@@ -247,6 +264,11 @@ def _row(model, own: tuple[str, ...], info, data: dict, template: dict | None, n
     default = not present
     if default:
         value = None if info.is_required() else info.get_default(call_default_factory=True)
-    overridden = key in named or (template is not None and present and (not in_file or file_value != value))
+    overridden = key in named or (template is not None and present
+                                  and ((in_file and file_value != value) or (given and not in_file)))
+    note = notes.get(key, "")
+    if present and not given:
+        note = ("from the material's name (gearcheck's materials table)" if key.endswith("cte_per_K")
+                else "derived by the run")
     return InputRow(key, show(value), unit, info.description or "", allowed,
-                    show(file_value) if in_file else "", overridden, notes.get(key, ""), section_note, default)
+                    show(file_value) if in_file else "", overridden, note, section_note, default)

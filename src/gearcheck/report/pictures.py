@@ -48,6 +48,9 @@ RED, BLUE, ORANGE = (0.85, 0.1, 0.1), (0.1, 0.3, 0.9), (0.88, 0.54, 0.0)
 SECTION_SHADE = 0.6  # a section's cut faces: the part's colour this much darker
 FADED_OPACITY = 0.14
 TIMEOUT_S = 300.0
+# At most this many worst poses are drawn (the closest: a large assembly has one per pair, and
+# each picture of a scene of many parts takes VTK about a second); the GLB and the 3D view keep all.
+MAX_WORST_PICTURES = 12
 
 
 class PicturesUnavailable(RuntimeError):
@@ -451,9 +454,13 @@ class _Drawer:
         return {"assembly.png": stage.png()}
 
     def worst(self, scene: Scene) -> dict[str, bytes]:
-        """The worst poses of ``scene`` (the stage's scene with its worst poses)."""
+        """The worst poses of ``scene`` (the stage's scene with its worst poses; the closest
+        :data:`MAX_WORST_PICTURES` of them where there are more: :func:`drawn_worst`)."""
         stage, out = self.stage, {}
+        drawn = set(drawn_worst(scene.worst))
         for i, view in enumerate(scene.worst, start=1):
+            if i not in drawn:
+                continue
             stage.clear()
             stage.cut(None)
             names = pair(view)
@@ -477,6 +484,17 @@ class _Drawer:
             stage.text([line for line in lines if line])
             out[f"worst_{i}.png"] = stage.png()
         return out
+
+
+def drawn_worst(views: list[PoseView]) -> list[int]:
+    """The worst poses that get a picture (their numbers, from 1, in order): every one, or, where
+    there are more than :data:`MAX_WORST_PICTURES`, those with the least distance."""
+    def distance(k: int) -> float:
+        d = views[k].distance_mm
+        return d if d is not None and math.isfinite(d) else math.inf
+
+    order = sorted(range(len(views)), key=lambda k: (distance(k), k))
+    return sorted(k + 1 for k in order[:MAX_WORST_PICTURES])
 
 
 def _child() -> int:

@@ -22,7 +22,7 @@ from gearcheck.pipeline import ProgressFactory, no_progress
 from gearcheck.studies import stats
 from gearcheck.studies.run import Base, run_level
 from gearcheck.studies.sampling import draw, field_values, integer_fields, nominal_values
-from gearcheck.studies.spec import (FIGURE_LEVELS, StudySpec, check_outputs, check_scheduler, load_spec,
+from gearcheck.studies.spec import (FIGURE_LEVELS, StudySpec, check_fields, check_outputs, check_scheduler, load_spec,
                                     template_path, with_flags)
 
 log = logging.getLogger("gearcheck")
@@ -321,6 +321,7 @@ def study(path: str | Path, *, samples: int | None = None, seed: int | None = No
     spec = with_flags(load_spec(path), samples=samples, seed=seed, exact=exact, check_worst=check_worst)
     tpl = template_path(spec, path)
     design = load(tpl)
+    check_fields(spec, type(design.params), str(path))
     n, s, k = spec.samples, spec.seed, spec.check_worst
     nominal = nominal_values(design.data, [i.field for i in spec.inputs])
     base = Base(design.mechanism, design.data, integer_fields(spec, nominal))

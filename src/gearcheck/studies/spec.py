@@ -211,6 +211,37 @@ def check_scheduler(address: str | None) -> str | None:
     return address
 
 
+def check_fields(spec: StudySpec, model: Any, study_file: str = "") -> None:
+    """Every input's ``field`` names a number of the template's mechanism (``model``: its
+    parameters' pydantic model), checked before any variant is drawn: an unknown key is one line
+    naming the input, the key and the keys allowed where it stops."""
+    from gearcheck.params.common import field_info
+
+    for i, inp in enumerate(spec.inputs):
+        path = tuple(inp.field.split("."))
+        if field_info(model, path) is not None:
+            continue
+        known = path[:-1]
+        while known and field_info(model, known) is None:
+            known = known[:-1]
+        section = field_info(model, known).annotation if known else model
+        keys = sorted(getattr(_unwrap_model(section), "model_fields", {}))
+        where = ".".join(known) or "the template"
+        raise ParamError(f"inputs[{i}].field", inp.field,
+                         f"unknown key: allowed keys in {where}: {', '.join(keys) or 'none'}", study_file)
+
+
+def _unwrap_model(annotation: Any) -> Any:
+    """The section model inside ``X | None``."""
+    import types
+    import typing
+
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(annotation) if a is not type(None)]
+        return args[0] if len(args) == 1 else annotation
+    return annotation
+
+
 def check_outputs(spec: StudySpec, figures: set[str], study_file: str = "") -> None:
     """``rank_by``, each failure's and each paper figure's output must be one of ``figures``
     (the mechanism's study figures, ``LEVEL.KEY``); a study that ranks or counts by a figure

@@ -56,6 +56,18 @@ class Rotation:
         m[:3, 3] = o - r @ o
         return m
 
+    def matrices(self, angles_rad: np.ndarray) -> np.ndarray:
+        """:meth:`matrix` at every angle of ``angles_rad`` at once: (n, 4, 4)."""
+        a = np.asarray(angles_rad, float).reshape(-1)
+        k = np.asarray(self.axis, float)
+        kx = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
+        r = np.eye(3) + np.sin(a)[:, None, None] * kx + (1.0 - np.cos(a))[:, None, None] * (kx @ kx)
+        m = np.broadcast_to(np.eye(4), (len(a), 4, 4)).copy()
+        m[:, :3, :3] = r
+        o = np.asarray(self.origin, float)
+        m[:, :3, 3] = o - r @ o
+        return m
+
     def to_dict(self) -> dict:
         return {"kind": self.kind, "axis": list(self.axis), "origin": list(self.origin)}
 
@@ -74,6 +86,13 @@ class Translation:
     def matrix(self, distance_mm: float) -> np.ndarray:
         m = np.eye(4)
         m[:3, 3] = np.asarray(self.axis, float) * distance_mm
+        return m
+
+    def matrices(self, distances_mm: np.ndarray) -> np.ndarray:
+        """:meth:`matrix` at every distance of ``distances_mm`` at once: (n, 4, 4)."""
+        d = np.asarray(distances_mm, float).reshape(-1)
+        m = np.broadcast_to(np.eye(4), (len(d), 4, 4)).copy()
+        m[:, :3, 3] = np.asarray(self.axis, float)[None, :] * d[:, None]
         return m
 
     def to_dict(self) -> dict:

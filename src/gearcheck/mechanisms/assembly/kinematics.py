@@ -37,6 +37,11 @@ class JointLine:
         """World transform of the part at its own coordinate ``q`` (deg or mm)."""
         return self.motion.matrix(math.radians(q) if self.unit == "deg" else q)
 
+    def matrices(self, q: np.ndarray) -> np.ndarray:
+        """:meth:`matrix` at every coordinate of ``q`` at once: (n, 4, 4)."""
+        q = np.asarray(q, float)
+        return self.motion.matrices(np.radians(q) if self.unit == "deg" else q)
+
 
 @dataclass(frozen=True)
 class Kinematics:
@@ -61,6 +66,15 @@ class Kinematics:
         if line is None:
             return np.eye(4)
         return line.matrix(line.coordinate(x) + extra)
+
+    def poses(self, part: str, xs: np.ndarray) -> np.ndarray:
+        """:meth:`pose` at every driver coordinate of ``xs`` at once: (n, 4, 4)."""
+        xs = np.asarray(xs, float).reshape(-1)
+        line = self.lines.get(part)
+        if line is None:
+            return np.broadcast_to(np.eye(4), (len(xs), 4, 4)).copy()
+        q = line.gain * xs + line.offset if line.coupled else np.zeros_like(xs)
+        return line.matrices(q)
 
 
 def _motion(kind: str, axis, point) -> Rotation | Translation:

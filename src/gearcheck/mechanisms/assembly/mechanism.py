@@ -21,6 +21,18 @@ if TYPE_CHECKING:
 DISPLAY_FRAMES = 48
 
 
+def motion_setting(params: AssemblyParams) -> tuple[str, float, str, float]:
+    """The template field that sets the poses (``motion.step_deg``, or ``motion.stops_deg`` as a
+    count), its value, its unit and the motion's extent (0 for stops): what a refusal names."""
+    joint = params.joint_of(params.motion.part)
+    unit = joint.unit if joint is not None else "deg"
+    stops = getattr(params.motion, f"stops_{unit}")
+    if stops is not None:
+        return f"motion.stops_{unit}", float(len(stops)), unit, 0.0
+    start, end = getattr(params.motion, f"start_{unit}"), getattr(params.motion, f"end_{unit}")
+    return f"motion.step_{unit}", float(getattr(params.motion, f"step_{unit}")), unit, abs(float(end) - float(start))
+
+
 class StepAssembly(Mechanism):
     """Any STEP assembly: parts by their products, joints, couples and a driving motion declared
     in the template (docs/assembly.md)."""
@@ -82,7 +94,7 @@ class StepAssembly(Mechanism):
              options: Mapping[str, Any] | None = None) -> SweepPlan:
         from gearcheck.mechanisms.assembly.sweep import plan_sweep
 
-        return plan_sweep(assembly, bodies, options)
+        return plan_sweep(assembly, bodies, options, motion_setting(params))
 
     def verdicts(self, params: AssemblyParams, outcome: SweepOutcome) -> list[Verdict]:
         from gearcheck.mechanisms.assembly.report import assembly_verdicts

@@ -91,32 +91,119 @@ def base_margin(lay: Layout) -> float:
     return max(1.0, 2.0 * max(required, default=0.0), 2.0 * lay.contact_tolerance_mm)
 
 
+def swept_capsule(kin: Kinematics, part: str, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+    """A capsule (a segment and a radius, world) holding ``part`` wherever its coupled motion takes
+    it, between the poses too: a turning part's cylinder of revolution about its axis (any turn), a
+    sliding part's box swept over its stroke, a part the motion does not move its box's sphere."""
+    centre = corners.mean(axis=0)
+    half = 0.5 * float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0)))
+    line = kin.lines.get(part)
+    if line is None or part not in kin.moving():
+        return centre, centre, half
+    axis = np.asarray(line.motion.axis, float)
+    if isinstance(line.motion, Rotation):
+        origin = np.asarray(line.motion.origin, float)
+        v = corners - origin
+        h = v @ axis
+        radius = float(np.linalg.norm(v - np.outer(h, axis), axis=1).max())
+        return origin + axis * h.min(), origin + axis * h.max(), radius
+    q = line.gain * kin.coordinates + line.offset
+    return centre + axis * float(q.min()), centre + axis * float(q.max()), half
+
+
+# The pruning places the parts at every s-th pose where s steps move no point more than this share
+# of the base margin (the margins grow by the larger step between the poses it keeps).
+PRUNE_STEP_SHARE = 0.125
+
+
+def pruning_coordinates(kin: Kinematics, corners: Mapping[str, np.ndarray], base: float) -> np.ndarray:
+    """The driver coordinates the pruning places the parts at: every pose, or, where the poses are
+    much closer together than the margin needs (a fine step), every s-th of them and the last, s
+    steps moving no point of any part more than :data:`PRUNE_STEP_SHARE` of the base margin. Each
+    pruning step adds the largest step between the coordinates it keeps to its margin, so it stays
+    right: it keeps more faces where it keeps fewer poses, in time and memory that do not grow with
+    a finer motion."""
+    x = kin.coordinates
+    if len(x) <= 2:
+        return x
+    dx = float(np.abs(np.diff(x)).max())
+    step = max((reach_mm(kin, p, abs(kin.lines[p].gain) * dx, corners[p]) for p in kin.moving() if p in corners),
+               default=0.0)
+    stride = int(PRUNE_STEP_SHARE * base / step) if step > 0.0 else 1
+    if stride <= 1:
+        return x
+    return np.concatenate([x[::stride], x[-1:]]) if (len(x) - 1) % stride else x[::stride]
+
+
+def near_pairs(lay: Layout, kin: Kinematics, corners: Mapping[str, np.ndarray], growth: float) -> np.ndarray:
+    """Which pairs (in ``lay.pairs`` order) can come within the pruning margin over the motion, from
+    a lower bound of their distance over the whole motion, between the poses too (the larger of: the
+    gap between their swept boxes less each one's largest step between poses; the gap between their
+    swept capsules): the pairs the faces are then pruned for. The margin here is the pruning
+    margin less its step term (the bound holds between the poses): the base margin, the play searched
+    (or the base margin again), the thermal growth of both."""
+    from gearcheck.sweep.prune import box_gaps, segment_distances, swept_box
+
+    if not lay.pairs:
+        return np.zeros(0, bool)
+    base = base_margin(lay)
+    names = list(corners)
+    index = {p: k for k, p in enumerate(names)}
+    moving = set(kin.moving())
+    coordinates = pruning_coordinates(kin, corners, base)
+    lo, hi, step = np.empty((len(names), 3)), np.empty((len(names), 3)), np.empty(len(names))
+    seg = np.empty((2, len(names), 3))
+    radius = np.empty(len(names))
+    for k, p in enumerate(names):
+        xs = coordinates if p in moving else coordinates[:1]
+        lo[k], hi[k], step[k] = swept_box(corners[p], kin.poses(p, xs))
+        seg[0, k], seg[1, k], radius[k] = swept_capsule(kin, p, corners[p])
+    i = np.array([index[r.a] for r in lay.pairs])
+    j = np.array([index[r.b] for r in lay.pairs])
+    play_reach = {p: reach_mm(kin, p, lay.play_limit, corners[p]) for p in names if p == lay.play}
+    reach = np.array([max([play_reach.get(r.a, 0.0), play_reach.get(r.b, 0.0), base]) for r in lay.pairs])
+    lower = np.maximum(box_gaps(lo, hi, i, j) - step[i] - step[j],
+                       segment_distances(seg[0, i], seg[1, i], seg[0, j], seg[1, j]) - radius[i] - radius[j])
+    return lower <= base + reach + 2.0 * growth
+
+
 def pair_meshes(lay: Layout, kin: Kinematics, bodies: Mapping[str, Body], states: list[StateSpec]
                 ) -> tuple[dict[str, tuple[MeshData, MeshData]], frozenset[str], dict[str, float], float]:
     """Each pair's two meshes pruned to what comes within the margin of the other over the motion
     (:mod:`gearcheck.sweep.prune`); the pairs never within it; each pair's clearing-move reach (the
-    mover's unit: a move that displaces no point more than the base margin); the base margin."""
+    mover's unit: a move that displaces no point more than the base margin); the base margin.
+    Pairs whose swept volumes never come within the margin (:func:`near_pairs`) are far without
+    a face placed; the others' relative poses are computed for all poses at once."""
+    from gearcheck.sweep.prune import relative_poses
+
     base = base_margin(lay)
     corners = {p: box_corners(b.mesh) for p, b in bodies.items()}
     growth = max((abs(st.scales.get(p, 1.0) - 1.0) * float(np.linalg.norm(c - np.asarray(st.datums.get(p, (0, 0, 0))),
                                                                           axis=1).max())
                   for st in states for p, c in corners.items()), default=0.0)
+    unit_reach = {p: reach_mm(kin, p, 1.0, corners[p]) for p in bodies}  # mm per unit move (deg or mm)
+    near = near_pairs(lay, kin, corners, growth)
+    coordinates = pruning_coordinates(kin, corners, base)
     meshes, far, reach = {}, set(), {}
-    for rule in lay.pairs:
+    for rule, candidate in zip(lay.pairs, near, strict=True):
         mover = overlap_mover(kin, rule)
         if mover is None:
             reach[rule.key] = 0.0
         else:
-            unit_reach = reach_mm(kin, mover, 1.0, corners[mover])  # mm per unit move (deg or mm)
-            reach[rule.key] = base / unit_reach if unit_reach > 0 else 0.0
+            reach[rule.key] = base / unit_reach[mover] if unit_reach[mover] > 0 else 0.0
+        if not candidate:
+            far.add(rule.key)
+            continue
         play_reach = max((reach_mm(kin, p, lay.play_limit, corners[p]) for p in (rule.a, rule.b) if p == lay.play),
                          default=0.0)
-        xs = kin.coordinates if rule.moving else kin.coordinates[:1]
+        xs = coordinates if rule.moving else coordinates[:1]
+        pose_a, pose_b = kin.poses(rule.a, xs), kin.poses(rule.b, xs)
         masks = []
-        for me, other in ((rule.a, rule.b), (rule.b, rule.a)):
-            rel = np.array([np.linalg.inv(kin.pose(me, float(x))) @ kin.pose(other, float(x)) for x in xs])
-            margin = base + max(base, play_reach) + largest_step(corners[other], rel) + 2.0 * growth
-            masks.append(near_faces(bodies[me].mesh, bodies[other].mesh, rel, margin))
+        for me, other, rel in ((rule.a, rule.b, relative_poses(pose_a, pose_b)),
+                               (rule.b, rule.a, relative_poses(pose_b, pose_a))):
+            step = largest_step(corners[other], rel)
+            margin = base + max(base, play_reach) + step + 2.0 * growth
+            masks.append(near_faces(bodies[me].mesh, bodies[other].mesh, rel, margin, step=step))
         if not masks[0].any() or not masks[1].any():
             far.add(rule.key)
             continue

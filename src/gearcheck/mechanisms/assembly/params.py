@@ -46,11 +46,13 @@ from typing import Any, Literal
 from pydantic import Field, ValidationInfo, field_validator, model_validator
 
 from gearcheck.geometry import materials
+from gearcheck.names import PART_RULE, PART_SCHEMA_PATTERN, name_problem
 from gearcheck.params import Problems, Section
 from gearcheck.params.common import fmt_bound
 
 MAX_PARTS = 200
 MAX_POSES = 100_000
+AXIS_MAX = 1e6  # largest component of a joint's axis (any length but zero: it is normalised)
 # a STEP file opens with this (ISO 10303-21); anything else is not a STEP file
 STEP_MAGIC = b"ISO-10303-21"
 
@@ -104,9 +106,11 @@ class AssemblySection(Section):
 
 
 class PartEntry(Section):
-    name: str = Field(min_length=1, max_length=200, pattern=r"^[^\s.][^.]*$",
-                      description="The part's name in gearcheck (no dots): the product of the file by default")
-    product: str | None = Field(None, min_length=1, max_length=400,
+    name: str = Field(min_length=1, max_length=400,
+                      description="The part's name in gearcheck, which names its files: " + PART_RULE[len("allowed "):]
+                                  + "; the product of the file by default",
+                      json_schema_extra={"pattern": PART_SCHEMA_PATTERN})
+    product: str | None = Field(None, min_length=1, max_length=4096,
                                 description="The product (or instance) name in the STEP file, if not `name`")
     step: str | None = Field(None, min_length=1, max_length=4096,
                              description="Another STEP file for this part (default: assembly.step)")
@@ -122,6 +126,14 @@ class PartEntry(Section):
     def _absolute(cls, value: str | None, info: ValidationInfo) -> str | None:
         return None if value is None else _resolve(value, info)
 
+    @field_validator("name")
+    @classmethod
+    def _file_name(cls, value: str) -> str:
+        why = name_problem(value, dots=False)
+        if why:
+            raise ValueError(why + " (a product's own name goes in product = \"...\")")
+        return value
+
     @property
     def product_name(self) -> str:
         return self.product or self.name
@@ -133,6 +145,17 @@ class Joint(Section):
                                                                "(slides along one)")
     axis: Vector = _vector("Direction of the axis (the file's frame; any length but zero)")
     point: Vector = _vector("A point on a revolute axis (mm, the file's frame)", [0.0, 0.0, 0.0])
+
+    @field_validator("axis")
+    @classmethod
+    def _direction(cls, value: Vector) -> Vector:
+        """The axis as a unit vector (a direction: its length does not count); components beyond
+        ±1e6 are refused, so no length computed from them can overflow."""
+        if any(not abs(c) <= AXIS_MAX for c in value):
+            raise ValueError(f"allowed components from {-AXIS_MAX:g} to {AXIS_MAX:g} (a direction: only its "
+                             "direction counts, e.g. [0, 0, 1])")
+        length = math.hypot(*value)
+        return [c / length for c in value] if length > 1e-12 else list(value)
 
     @property
     def unit(self) -> str:

@@ -20,7 +20,7 @@ class StateResult:
     """One state's arrays over the poses (in pose order)."""
 
     name: str
-    clearance: np.ndarray  # (poses, pairs) mm; NaN where not measured; −overlap where overlapping
+    clearance: np.ndarray  # (poses, pairs queried: Spec.live) mm; NaN where not measured; −overlap where overlapping
     overlap_mm: np.ndarray  # (poses, pairs) overlap along the motion, mm (NaN: apart; inf: jammed)
     overlap_unit: np.ndarray  # the same in the mover's unit
     points: np.ndarray  # (poses, pairs, 6) nearest points where apart
@@ -64,7 +64,7 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
     kin = spec.kin
     count = len(kin.coordinates)
     unit = kin.unit
-    data = _gather(results, states, len(spec.pairs), count)
+    data = _gather(results, states, len(spec.live), count)
     queries = int(sum(r["queries"] for r in results))
     bound = {r.key: bodies[r.a].error_bound_mm + bodies[r.b].error_bound_mm for r in spec.pairs}
     by_name = {st.name: st for st in states}
@@ -72,9 +72,11 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
                      "motion_start": float(kin.coordinates[0]), "motion_end": float(kin.coordinates[-1]),
                      "contact_tolerance_mm": lay.contact_tolerance_mm,
                      "mesh_error_bound_mm": max(bound.values()) if bound else 0.0, "fcl_queries": queries,
-                     "pruning_margin_mm": spec.margin}
+                     "pruning_margin_mm": spec.margin, "pairs_checked": len(spec.pairs),
+                     "pairs_queried": len(spec.live), "pairs_never_near": len(spec.far)}
     worst: list[WorstPose] = []
-    pairs = {rule.key: _pair_entry(k, rule, lay, spec, data, by_name, bound[rule.key], worst)
+    column = {k: c for c, k in enumerate(spec.live)}
+    pairs = {rule.key: _pair_entry(column.get(k), rule, lay, spec, data, by_name, bound[rule.key], worst)
              for k, rule in enumerate(spec.pairs)}
     _certificates(spec, states, results, pairs)
     for rule in spec.pairs:
@@ -92,7 +94,8 @@ def reduce_sweep(lay: Layout, spec: Spec, states: list[StateSpec], bodies: Mappi
         summary.update(_play_summary(spec, data, by_name, worst, unit))
     play_s = [t for r in results for t in r["play_s"]]
     task_s = sum(r["seconds"] for r in results)
-    timings: dict = {"fcl_queries": queries, "task_s": task_s, "poses_per_task_s": count * len(states) / task_s}
+    timings: dict = {"fcl_queries": queries, "task_s": task_s, "poses_per_task_s": count * len(states) / task_s,
+                     "task_cpu_s": sum(float(r.get("cpu_s", r["seconds"])) for r in results)}
     if play_s:
         timings.update(ms_per_play_measurement=1e3 * float(np.mean(play_s)),
                        ms_per_play_measurement_max=1e3 * float(np.max(play_s)))
@@ -123,13 +126,16 @@ def _certificates(spec: Spec, states: list[StateSpec], results: list, pairs: dic
                 entry.pop(key)
 
 
-def _pair_entry(k: int, rule, lay: Layout, spec: Spec, data: list[StateResult], by_name: dict[str, StateSpec],
-                bound: float, worst: list[WorstPose]) -> dict:
+def _pair_entry(k: int | None, rule, lay: Layout, spec: Spec, data: list[StateResult],
+                by_name: dict[str, StateSpec], bound: float, worst: list[WorstPose]) -> dict:
     """One pair's figures over the motion and the states (its worst poses appended to ``worst``):
-    the least clearance where apart, the deepest overlap where not, the poses touching."""
+    the least clearance where apart, the deepest overlap where not, the poses touching. ``k``: its
+    column in the arrays (None: a pair never queried)."""
     kin, unit = spec.kin, spec.kin.unit
     entry: dict = {"rule": rule.kind, "required_mm": rule.min_clearance_mm, "mesh_error_bound_mm": bound,
                    "moving": int(rule.moving)}
+    if k is None:
+        return {"overlapping_poses": 0, "touching_poses": 0, **entry}
     least, least_at = math.inf, None
     deepest, deepest_at, overlapping, touching = -math.inf, None, 0, 0
     for sr in data:

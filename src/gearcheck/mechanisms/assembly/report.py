@@ -200,22 +200,23 @@ def assembly_report(outcome: SweepOutcome, verdicts: Sequence[Verdict]) -> Repor
     kin, unit = data.spec.kin, s["motion_unit"]
     x = [float(v) for v in kin.coordinates]
     rows: list[dict] = []
+    live = data.spec.live_rules
     for sr in data.states:
         for i, xi in enumerate(x):
             row: dict = {"state": sr.name, f"{kin.driver}_{unit}": xi}
-            for k, rule in enumerate(data.spec.pairs):
+            for k, rule in enumerate(live):  # the pairs queried (the others: never within the margin)
                 row[f"clearance_{rule.key}_mm"] = float(sr.clearance[i, k])
             if data.spec.play:
                 pu = s["play_unit"]
                 row[f"play_plus_{pu}"], row[f"play_minus_{pu}"] = float(sr.play[i, 0]), float(sr.play[i, 1])
             rows.append(row)
     plots = []
-    shown = [r for r in data.spec.pairs if r.declared and r.moving] or [r for r in data.spec.pairs if r.moving]
+    shown = [r for r in live if r.declared and r.moving] or [r for r in live if r.moving]
     if shown:
         series = []
         for sr in data.states:
             for rule in shown[:8]:
-                k = data.spec.pairs.index(rule)
+                k = live.index(rule)
                 label = f"{rule.a} – {rule.b}" + ("" if sr.name == "as_built" else f" ({sr.name})")
                 series.append(Series(label, x, _finite(sr.clearance[:, k])))
         hl = [(f"required {r.a} – {r.b}", r.min_clearance_mm) for r in shown[:8] if r.kind == "clearance"

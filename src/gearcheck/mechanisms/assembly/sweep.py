@@ -21,7 +21,7 @@ play, over the motion and the states, and names the worst poses for the exact B-
 
 from __future__ import annotations
 
-import functools
+import dataclasses
 import math
 import time
 from collections.abc import Mapping
@@ -74,6 +74,9 @@ class Spec:
     hulls: dict[str, tuple[np.ndarray, np.ndarray]]
     grown: float  # the largest thermal scale: a state's meshes are no larger than this times the built
     resolution: dict[str, float]  # per pair: its mesh-error bound, the sharpest a bound can be
+    # the pairs queried (not far), as indices into ``pairs``: the columns of every task's arrays
+    live: tuple[int, ...] = ()
+    index: dict[frozenset[str], int] = dataclasses.field(default_factory=dict)  # {a, b} → its index in pairs
 
     def mesh(self, rule: PairRule, part: str, state: str) -> str:
         """The mesh of ``part`` against the other part of ``rule``, in ``state``."""
@@ -81,7 +84,29 @@ class Spec:
         return name if state == AS_BUILT else f"{name}@{state}"
 
     def rule(self, a: str, b: str) -> PairRule:
-        return next(r for r in self.pairs if {r.a, r.b} == {a, b})
+        k = self.index.get(frozenset((a, b)))
+        return self.pairs[k] if k is not None else next(r for r in self.pairs if {r.a, r.b} == {a, b})
+
+    def queried(self, a: str, b: str) -> bool:
+        """Whether the pair of ``a`` and ``b`` is queried (checked, and not far)."""
+        k = self.index.get(frozenset((a, b)))
+        return k is not None and self.pairs[k].key not in self.far
+
+    def for_tasks(self) -> Spec:
+        """This spec as the tasks need it: the queried pairs only (their columns in order), so that
+        what is sent with every task does not grow with the pairs never near (19,900 of a 200-part
+        assembly's, against its 370 queried)."""
+        live = self.live_rules
+        keys = {r.key for r in live}
+        return dataclasses.replace(self, pairs=tuple(live), live=tuple(range(len(live))), far=frozenset(),
+                                   reach={k: v for k, v in self.reach.items() if k in keys},
+                                   resolution={k: v for k, v in self.resolution.items() if k in keys},
+                                   index={frozenset((r.a, r.b)): k for k, r in enumerate(live)})
+
+    @property
+    def live_rules(self) -> list[PairRule]:
+        """The pairs queried, in column order."""
+        return [self.pairs[k] for k in self.live]
 
 
 def _unit_tol(unit: str) -> float:
@@ -170,7 +195,7 @@ def _play(scene: CountedScene, spec: Spec, state: str, x: float, overlapping: bo
     part = spec.play
     assert part is not None
     line = spec.kin.lines[part]
-    near = [n for n in spec.play_neighbours if spec.rule(part, n).key not in spec.far]
+    near = [n for n in spec.play_neighbours if spec.queried(part, n)]
     pairs = [spec.rule(part, n) for n in near]
     mine = [spec.mesh(r, part, state) for r in pairs]  # whole pruned meshes: the pose itself
     others = [spec.mesh(r, r.b if r.a == part else r.a, state) for r in pairs]
@@ -229,8 +254,15 @@ def _certified(scene: CountedScene, spec: Spec, rule: PairRule, state: str, xs: 
             return -depth if math.isfinite(depth) and depth > 0.0 else -BISECT_MM
         return scene.distance(a, b).distance
 
-    cert = certify(xs, cs, measure, functools.partial(interval_path, spec, rule), rule.min_clearance_mm,
-                   spec.resolution[rule.key])
+    # the poses' own intervals at once; a refinement's halves one by one
+    spans = list(zip(xs[:-1], xs[1:], strict=True))
+    paths = dict(zip(spans, interval_paths(spec, rule, np.asarray(xs[:-1]), np.asarray(xs[1:])), strict=True))
+
+    def path(x0: float, x1: float) -> float:
+        found = paths.get((x0, x1))
+        return found if found is not None else interval_path(spec, rule, x0, x1)
+
+    cert = certify(xs, cs, measure, path, rule.min_clearance_mm, spec.resolution[rule.key])
     return {"certified_min": cert.certified_min, "sampled_min": cert.sampled_min, "at": list(cert.at),
             "refined": cert.refined, "undecided": len(cert.undecided)}
 
@@ -241,8 +273,8 @@ def _certificates(scene: CountedScene, spec: Spec, state: str, indices: list[int
     on to the pose ``after`` (the next task's first: measured here, not recorded)."""
     kin = spec.kin
     certificates: dict[str, dict] = {}
-    for k, rule in enumerate(spec.pairs):
-        if rule.key in spec.far or not rule.moving or rule.kind == "contact":
+    for k, rule in enumerate(spec.live_rules):
+        if not rule.moving or rule.kind == "contact":
             continue
         xs = [float(kin.coordinates[i]) for i in indices]
         cs = [float(c) for c in clearance[:, k]]
@@ -262,16 +294,17 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     them, where pairs that do not move relative to each other are checked), and each moving pair's
     clearance certified over the motion from the first of them to the pose ``after`` (the next
     task's first, measured here too, not recorded: every interval is certified by one task)."""
-    live = [r for r in spec.pairs if r.key not in spec.far]
-    names = {spec.mesh(r, p, state) for r in live for p in (r.a, r.b)}
-    if spec.play:  # the play part's directed meshes too: BVHs are built here, not in a measurement's time
-        suffix = "" if state == AS_BUILT else f"@{state}"
-        names |= {n + suffix for (other, _), pair in spec.play_meshes.items()
-                  if spec.rule(spec.play, other).key not in spec.far for n in pair}
-    scene.build(sorted(names))
+    cpu0 = time.process_time()
+    live = spec.live_rules
+    scene.build(task_meshes(spec, state))
     scene = CountedScene(scene)
     kin = spec.kin
-    n, m = len(indices), len(spec.pairs)
+    n, m = len(indices), len(live)
+    meshes = [(spec.mesh(r, r.a, state), spec.mesh(r, r.b, state)) for r in live]
+    placed = sorted({(name, part) for r, pair in zip(live, meshes, strict=True)
+                     for name, part in zip(pair, (r.a, r.b), strict=True)})
+    parts = sorted({part for _, part in placed})
+    mine = [k for k, r in enumerate(live) if spec.play in (r.a, r.b)]  # the play part's pairs
     clearance = np.full((n, m), np.nan)
     overlap_mm = np.full((n, m), np.nan)
     overlap_unit = np.full((n, m), np.nan)
@@ -282,11 +315,11 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     cuts = Cuts(scene.scene)
     for row, i in enumerate(indices):
         x = float(kin.coordinates[i])
-        scene.set_poses({spec.mesh(r, p, state): kin.pose(p, x) for r in live for p in (r.a, r.b)})
-        for k, rule in enumerate(spec.pairs):
-            if rule.key in spec.far or (not rule.moving and not (first and i == 0)):
+        at = {p: kin.pose(p, x) for p in parts}
+        scene.set_poses({name: at[part] for name, part in placed})
+        for k, (rule, (a, b)) in enumerate(zip(live, meshes, strict=True)):
+            if not rule.moving and not (first and i == 0):
                 continue
-            a, b = spec.mesh(rule, rule.a, state), spec.mesh(rule, rule.b, state)
             if scene.collide(a, b):
                 overlap_mm[row, k], overlap_unit[row, k] = _overlap(scene, spec, rule, state, x)
                 clearance[row, k] = -overlap_mm[row, k] if math.isfinite(overlap_mm[row, k]) else -math.inf
@@ -296,7 +329,6 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
                 points[row, k] = np.concatenate([d.point_a, d.point_b])
         if spec.play:
             t0 = time.perf_counter()
-            mine = [k for k, r in enumerate(spec.pairs) if spec.play in (r.a, r.b) and r.key not in spec.far]
             hit = any(np.isfinite(overlap_mm[row, k]) or np.isinf(overlap_mm[row, k]) for k in mine)
             free = all(clearance[row, k] > 0.0 for k in mine)  # each asked at this pose, and apart
             play[row] = _play(scene, spec, state, x, hit, (list(play[:row, 0]), list(play[:row, 1])), free, cuts)
@@ -305,7 +337,111 @@ def sweep_poses(scene, spec: Spec, state: str, indices: list[int], first: bool, 
     certificates = _certificates(scene, spec, state, indices, clearance, after)
     return {"indices": list(indices), "clearance": clearance, "overlap_mm": overlap_mm,
             "overlap_unit": overlap_unit, "points": points, "play": play, "queries": scene.queries,
-            "play_s": play_s, "seconds": time.perf_counter() - start, "certificates": certificates}
+            "play_s": play_s, "seconds": time.perf_counter() - start, "certificates": certificates,
+            "cpu_s": time.process_time() - cpu0}
+
+
+def task_meshes(spec: Spec, state: str) -> list[str]:
+    """The meshes a task of ``state`` queries: the queried pairs' and the play part's directed ones
+    (their BVHs are built before the poses, not in a measurement's time)."""
+    names = {spec.mesh(r, p, state) for r in spec.live_rules for p in (r.a, r.b)}
+    if spec.play:
+        suffix = "" if state == AS_BUILT else f"@{state}"
+        names |= {n + suffix for (other, _), pair in spec.play_meshes.items()
+                  if spec.queried(spec.play, other) for n in pair}
+    return sorted(names)
+
+
+# The sweep's cost is measured before it starts on at most this many of its queried pairs (spread
+# over their sizes), at runs of this many consecutive poses spread over the motion (one at least,
+# more until about CALIBRATION_S CPU seconds are spent, CALIBRATION_RUNS at most): the tasks' code.
+CALIBRATION_PAIRS = 8
+CALIBRATION_POSES = 12
+CALIBRATION_RUNS = 8
+CALIBRATION_S = 0.25
+
+
+@dataclass(frozen=True)
+class Calibration:
+    """What one pair at one pose costs (CPU s, with its share of the certificate), one play
+    measurement at one pose, one state's BVHs on one worker (from the sample's), and the time the
+    measurement took."""
+
+    pair_pose_s: float
+    play_pose_s: float
+    setup_s: float
+    seconds: float
+
+
+def calibrate(spec: Spec, meshes: list[MeshData]) -> Calibration:
+    """The cost of the sweep's work measured on a sample of it, in this process, on a scene of
+    its own (the results are the tasks', never the sample's): up to :data:`CALIBRATION_PAIRS`
+    queried pairs, spread over their triangle counts, at runs of consecutive poses spread over the
+    motion (queries, overlaps, the clearance certified between them): a first run of 2 poses, then
+    runs of :data:`CALIBRATION_POSES` while less than :data:`CALIBRATION_S` CPU seconds are spent
+    (an expensive pose is measured once or twice, a cheap one often). The play part's pairs with
+    its play measured, the play's share timed apart (it serves for the pairs too where the sample
+    is the play part's pairs)."""
+    from gearcheck.sweep.engine import Scene
+
+    t0 = time.perf_counter()
+    by_name = {m.name: m for m in meshes}
+    scene = Scene(meshes)  # BVHs built on first use: only the sample's
+    size = {k: sum(len(by_name[spec.mesh(spec.pairs[k], p, AS_BUILT)].faces) for p in (spec.pairs[k].a,
+                                                                                     spec.pairs[k].b))
+            for k in spec.live}
+    moving = [k for k in spec.live if spec.pairs[k].moving]
+    count = len(spec.kin.coordinates)
+    spread = [(2 * i + 1) * count // (2 * CALIBRATION_RUNS) for i in range(CALIBRATION_RUNS)]
+    spread = spread[::2] + spread[1::2]  # every other first: the first runs span the motion
+
+    def run(sub: Spec, start: int, length: int, first: bool = False) -> tuple[float, float, int]:
+        """(CPU seconds, the play's seconds, poses) of one run."""
+        start = max(0, min(count - length, start))
+        idx = list(range(start, start + length)) if not first else [0]
+        after = idx[-1] + 1 if idx[-1] + 1 < count else None
+        scene.build(task_meshes(sub, AS_BUILT))
+        out = sweep_poses(scene, sub, AS_BUILT, idx, first, after)
+        return float(out["cpu_s"]), float(sum(out["play_s"])), len(idx)
+
+    def runs(sub: Spec) -> tuple[float, float, int]:
+        """CPU seconds, the play's seconds and poses of the runs: one at least, more while under
+        :data:`CALIBRATION_S`."""
+        spent = play = 0.0
+        poses = 0
+        for k, start in enumerate(spread):
+            if k and spent >= CALIBRATION_S:
+                break
+            cpu, p, n = run(sub, start, min(2 if k == 0 else CALIBRATION_POSES, count))
+            spent, play, poses = spent + cpu, play + p, poses + n
+        return spent, play, poses
+
+    pair_pose_s = play_pose_s = setup_s = 0.0
+    mine = tuple(k for k in spec.live if spec.play in (spec.pairs[k].a, spec.pairs[k].b)) if spec.play else ()
+    pool = moving or list(spec.live)
+    sample: tuple[int, ...] = ()
+    if pool:
+        ranked = sorted(pool, key=lambda k: (size[k], k))
+        n = min(CALIBRATION_PAIRS, len(ranked))
+        sample = tuple(sorted({ranked[round(i * (len(ranked) - 1) / max(1, n - 1))] for i in range(n)}))
+        sub = dataclasses.replace(spec, live=sample, play=None)
+        c0 = time.process_time()
+        scene.build(task_meshes(sub, AS_BUILT))
+        built_s = time.process_time() - c0
+        sampled = sum(len(by_name[m].faces) for m in task_meshes(sub, AS_BUILT))
+        every = sum(len(by_name[m].faces) for m in task_meshes(spec, AS_BUILT))
+        setup_s = built_s * every / max(sampled, 1)
+        if not moving:
+            pair_pose_s = run(sub, 0, 1, first=True)[0] / len(sample)
+        elif not (mine and set(sample) <= set(mine)):
+            spent, _, poses = runs(sub)
+            pair_pose_s = spent / (len(sample) * poses)
+    if mine:
+        spent, play, poses = runs(dataclasses.replace(spec, live=mine))
+        play_pose_s = play / poses
+        if moving and set(sample) <= set(mine):
+            pair_pose_s = max(0.0, spent - play) / (len(mine) * poses)
+    return Calibration(pair_pose_s, play_pose_s, setup_s, time.perf_counter() - t0)
 
 
 def _velocity(kin: Kinematics, part: str, w: np.ndarray) -> np.ndarray:
@@ -356,6 +492,25 @@ def interval_path(spec: Spec, rule: PairRule, x0: float, x1: float) -> float:
     return spec.grown * best
 
 
+def interval_paths(spec: Spec, rule: PairRule, x0: np.ndarray, x1: np.ndarray) -> np.ndarray:
+    """:func:`interval_path` over many intervals [x0[k], x1[k]] at once."""
+    dx = np.abs(np.asarray(x1, float) - np.asarray(x0, float))
+    if not len(dx):
+        return dx
+    kin = spec.kin
+    omega = float(np.linalg.norm(_turn_rate(kin, rule.a) - _turn_rate(kin, rule.b)))
+    best = np.full(len(dx), math.inf)
+    for part, other, points in ((rule.a, rule.b, spec.hulls[rule.key][0]), (rule.b, rule.a, spec.hulls[rule.key][1])):
+        m0 = kin.poses(part, x0)
+        w = (points[None, :, :] @ np.swapaxes(m0[:, :3, :3], 1, 2) + m0[:, None, :3, 3]).reshape(-1, 3)
+        own = _velocity(kin, part, w)
+        s0 = np.linalg.norm(own - _velocity(kin, other, w), axis=1).reshape(len(dx), -1)
+        speed = np.linalg.norm(own, axis=1).reshape(len(dx), -1)
+        path = s0 * dx[:, None] + omega * speed * (dx * dx / 2.0)[:, None]
+        best = np.minimum(best, path.max(axis=1))
+    return spec.grown * best
+
+
 def hull_points(mesh: MeshData) -> np.ndarray:
     """The vertices of the convex hull of a mesh's vertices (its part's frame): where a convex
     function of the point (a relative speed) is largest over the mesh. The box's corners where the
@@ -369,7 +524,14 @@ def hull_points(mesh: MeshData) -> np.ndarray:
         return _corners(mesh)
 
 
-def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None) -> SweepPlan:
+def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[str, Any] | None,
+               setting: tuple[str, float, str, float] = ("motion", math.nan, "", 0.0)) -> SweepPlan:
+    """The tasks (runs of consecutive poses of one state), the reduce step, and the sweep's cost
+    predicted from a measured sample of its work (:func:`calibrate`): ``setting`` is the template
+    field that sets the poses, its value, unit and the motion's extent (0: a list of stops), named
+    where the cost is over the budget."""
+    from gearcheck.sweep_budget import SweepCost
+
     lay: Layout = assembly.layout
     options = dict(options or {})
     kin = lay.kin
@@ -384,9 +546,12 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
     grown = 1.0 + max((abs(s - 1.0) for st in states for s in st.scales.values()), default=0.0)
     hulls = {key: (hull_points(ma), hull_points(mb)) for key, (ma, mb) in pairs.items()}
     resolution = {r.key: bodies[r.a].error_bound_mm + bodies[r.b].error_bound_mm for r in lay.pairs}
+    live = tuple(k for k, r in enumerate(lay.pairs) if r.key not in far)
+    index = {frozenset((r.a, r.b)): k for k, r in enumerate(lay.pairs)}
     spec = Spec(kin, lay.pairs, lay.play, lay.play_limit, lay.play_neighbours,
                 {k: (a.name, b.name) for k, (a, b) in pairs.items()}, far, reach, margin,
-                centres, play, hulls, grown, resolution)  # type: ignore[arg-type]
+                centres, play, hulls, grown, resolution, live, index)  # type: ignore[arg-type]
+    tasked = spec.for_tasks()
     per_task = int(options.get("poses_per_task", POSES_PER_TASK))
     count = len(kin.coordinates)
     tasks, weights = [], []
@@ -394,7 +559,7 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
         for start in range(0, count, per_task):
             idx = list(range(start, min(count, start + per_task)))
             after = idx[-1] + 1 if idx[-1] + 1 < count else None
-            tasks.append((sweep_poses, (spec, st.name, idx, start == 0, after)))
+            tasks.append((sweep_poses, (tasked, st.name, idx, start == 0, after)))
             weights.append(len(idx))
 
     def reduce(results: list) -> SweepOutcome:
@@ -404,8 +569,12 @@ def plan_sweep(assembly: Assembly, bodies: Mapping[str, Body], options: Mapping[
                             {k: (a.faces.shape[0], b.faces.shape[0]) for k, (a, b) in pairs.items()})
 
     every = {**{k: v for k, v in pairs.items()}, **{f"{n}{sign:+g}": m for (n, sign), m in directed.items()}}
-    return SweepPlan(state_meshes(states, bodies, every), tasks, reduce, weights=weights, unit="pose",
-                     options=options)
+    meshes = state_meshes(states, bodies, every)
+    cal = calibrate(tasked, meshes[:len(meshes) // len(states)])  # the file's own state: the first
+    static = sum(not lay.pairs[k].moving for k in live)
+    cost = SweepCost(count, len(states), len(live) - static, static, len(far), cal.pair_pose_s, cal.play_pose_s,
+                     cal.setup_s, cal.seconds, *setting)
+    return SweepPlan(meshes, tasks, reduce, weights=weights, unit="pose", options=options, cost=cost)
 
 
 def worst_pose(label: str, key: str, spec: Spec, state: StateSpec, a: str, b: str, x: float,

@@ -113,6 +113,7 @@ def new(inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
     --module with the least module whose derived design passes, found on the derivation itself."""
     m = positive_number("module", inputs["module"], *MODULE_RANGE)
     small, big = teeth_numbers(inputs["teeth"], 2, "small/big")
+    _teeth_in_range(inputs["teeth"], small, big)
     if small > big:
         raise ParamError("--teeth", inputs["teeth"], f"allowed small/big with small <= big, e.g. --teeth {big}/{small}")
     for key, flag in _INPUT_FIELDS.items():
@@ -122,20 +123,65 @@ def new(inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:
     problem = _problem(d, overrides)
     if problem is None:
         return d
-    if problem.field == "gears.module_mm":
-        def module_ok(v: float) -> bool:
-            try:
-                return _problem(derive(v, small, big, overrides), overrides) is None
-            except ParamError:
-                return False
+    teeth = ("gears.big_teeth", "gears.small_teeth")
+    if problem.field in teeth:
+        raise _teeth_error(inputs["teeth"], problem)
+    seen: list[ParamError] = []
 
-        least = bisect_boundary(module_ok, MODULE_RANGE[1], m, steps=40)
-        bound = (f"allowed >= {fmt_bound(least, 'lower', 2, ok=module_ok)} mm at {small}/{big} teeth (every value "
-                 "derived from it again)" if least is not None
-                 else f"no module up to {MODULE_RANGE[1]:g} mm allowed at {small}/{big} teeth")
-        raise ParamError("--module", m, f"{bound}: {problem.allowed.partition(': ')[2]}")
+    def module_ok(v: float) -> bool:
+        try:
+            found = _problem(derive(v, small, big, overrides), overrides)
+        except ParamError as exc:
+            found = exc
+        if found is not None:
+            seen.append(found)
+        return found is None
+
+    # the module too small (bores under the toe roots) or too large (a derived dimension out of its
+    # range): the nearest module whose derived design passes, found on the derivation itself
+    upward = problem.field == "gears.module_mm"
+    bound = _module_bound(module_ok, m, upward)
+    why = (problem.allowed.partition(": ")[2] if upward
+           else f"the derived {problem.field} = {problem.value}: {problem.allowed}")
+    if bound is None:  # a rule on the tooth counts (shown at another module), else the first one
+        on_teeth = next((e for e in seen if e.field in teeth), None)
+        if on_teeth is not None:
+            raise _teeth_error(inputs["teeth"], on_teeth)
+        raise ParamError("--teeth", inputs["teeth"], f"no module from {MODULE_RANGE[0]:g} to {MODULE_RANGE[1]:g} mm "
+                                                     f"allowed at {small}/{big} teeth: {why}")
+    side = f">= {fmt_bound(bound, 'lower', 2, ok=module_ok)}" if upward else \
+        f"<= {fmt_bound(bound, 'upper', 2, ok=module_ok)}"
+    raise ParamError("--module", m, f"allowed {side} mm at {small}/{big} teeth (every value derived from it again): "
+                                    f"{why}")
+
+
+def _teeth_error(given: Any, problem: ParamError) -> ParamError:
     which = problem.field.partition(".")[2].replace("_", " ")  # big teeth / small teeth
-    raise ParamError("--teeth", inputs["teeth"], f"{which}: {problem.allowed}")
+    return ParamError("--teeth", given, f"{which}: {problem.allowed}")
+
+
+def _module_bound(module_ok, m: float, upward: bool, samples: int = 24) -> float | None:
+    """Where the modules that pass begin above ``m`` (``upward``) or end below it: the first that
+    passes of ``samples`` modules spaced evenly in ratio from ``m`` to the end of the module's
+    range, then bisection back towards ``m``; None when none of them passes."""
+    end = MODULE_RANGE[1] if upward else MODULE_RANGE[0]
+    for k in range(1, samples + 1):
+        v = m * (end / m) ** (k / samples)
+        if module_ok(v):
+            return bisect_boundary(module_ok, v, m, steps=40)
+    return None
+
+
+def _teeth_in_range(given: Any, small: int, big: int) -> None:
+    """Each tooth count within its field's range (the cone geometry is derived from them: a count of
+    0 has no cone), one line naming both where both are out."""
+    out = []
+    for count, dotted in ((small, "gears.small_teeth"), (big, "gears.big_teeth")):
+        lo, hi = _limits(dotted) or (-math.inf, math.inf)
+        if not lo <= count <= hi:
+            out.append(f"{dotted.partition('.')[2].replace('_', ' ')} {count}: allowed {lo:g} to {hi:g}")
+    if out:
+        raise ParamError("--teeth", given, "; ".join(out) + " (small/big)")
 
 
 def derive(m: float, small: int, big: int, overrides: Mapping[str, Any]) -> Draft:
@@ -219,10 +265,15 @@ def _shift(geom: analysis.ConeGeometry, alpha: float, m: float) -> tuple[float, 
         return x, note
     bounds = P.shift_bounds(geom, alpha, min_tip)
     if bounds is None:
-        raise ParamError("--teeth", f"{geom.small_teeth}/{geom.big_teeth}",
-                         f"allowed tooth counts with a profile shift free of undercut, tip interference and pointed "
-                         f"teeth at α = {math.degrees(alpha):g}° (none for these; a larger pressure angle, "
-                         "--set gears.pressure_angle_deg, allows fewer small teeth)")
+        small, big = geom.small_teeth, geom.big_teeth
+        least = next((z for z in range(small + 1, big + 1)
+                      if P.shift_bounds(analysis.cone_geometry(m, big, z), alpha, min_tip) is not None), None)
+        counts = (f"allowed small teeth >= {least} with {big} big teeth" if least is not None
+                  else f"no small tooth count up to {big} allowed with {big} big teeth")
+        raise ParamError("--teeth", f"{small}/{big}",
+                         f"{counts} at α = {math.degrees(alpha):g}° (a profile shift free of undercut, tip "
+                         "interference and pointed teeth; a larger pressure angle, --set gears.pressure_angle_deg, "
+                         "allows fewer small teeth)")
     lo, hi = math.ceil(bounds[0] * 100 - 1e-9) / 100, math.floor(bounds[1] * 100 + 1e-9) / 100
     x = min(max(x, lo), hi) if lo <= hi else round((bounds[0] + bounds[1]) / 2.0, 4)
     return x, f"{note}, moved into the allowed {bounds[0]:.3f} to {bounds[1]:.3f}"
@@ -275,8 +326,9 @@ def _approach(geom: analysis.ConeGeometry, dim: dict, mat: dict, op: dict) -> tu
 
 def _problem(d: Draft, overrides: Mapping[str, Any]) -> ParamError | None:
     """The first rule the draft (with the overrides as written) breaks on a gear input (module,
-    tooth counts), or None. Anything else — an override out of range, a rule it breaks — is named
-    by the template's own validation when the draft is loaded, as written."""
+    tooth counts), else on a value derived from them (e.g. a housing length out of its range at a
+    large module), or None. A rule broken on an override (a value given with --set) is named by
+    the template's own validation when the draft is loaded, as written."""
     data = d.data()
     for dotted, value in overrides.items():
         section, _, key = dotted.partition(".")
@@ -287,5 +339,6 @@ def _problem(d: Draft, overrides: Mapping[str, Any]) -> ParamError | None:
         validate(P.Params, body)
     except ParamError as exc:
         errors = exc.errors if isinstance(exc, ParamErrors) else [exc]
-        return next((e for e in errors if e.field in _INPUT_FIELDS), None)
+        return next((e for e in errors if e.field in _INPUT_FIELDS),
+                    next((e for e in errors if e.field not in overrides), None))
     return None

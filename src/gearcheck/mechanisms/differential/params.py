@@ -18,6 +18,7 @@ from pydantic import Field, PrivateAttr, model_validator
 
 from gearcheck.mechanisms.differential import analysis, poses  # numpy only
 from gearcheck.mechanisms.differential import calibration as cal  # numpy only
+from gearcheck.geometry import materials
 from gearcheck.params.problems import Problems
 from gearcheck.params.common import MISSING, ParamError, Section, bisect_boundary, fmt_bound, fmt_range
 
@@ -27,6 +28,7 @@ from gearcheck.params.common import MISSING, ParamError, Section, bisect_boundar
 APEX_TOLERANCE_MM = 0.05
 MAX_STUDY_SHIMS = 12
 MATERIAL_NAME_MAX = 40
+MATERIAL_MEMBERS = ("housing", "shaft", "gear")  # materials.NAME, with materials.NAME_cte_per_K
 SHIFT_MIN, SHIFT_MAX = -1.0, 1.5  # the small gear's profile shift coefficient (field range)
 
 
@@ -143,12 +145,17 @@ class Backlash(Section):
 
 
 def _cte_field(what: str):
-    return Field(ge=0.0, le=100e-6, description=f"mean linear expansion coefficient of the {what}",
-                 json_schema_extra=_unit("1/K"))
+    # no default in the file: the material's name gives it (Materials._from_names fills it in)
+    return Field(None, ge=0.0, le=100e-6, description=f"mean linear expansion coefficient of the {what} (default: "
+                 "the material's, from gearcheck's materials table)", json_schema_extra=_unit("1/K"))
 
 
 class Materials(Section):
-    """Materials and their mean CTE over the warm–cold range (ξ1 housing, ξ2 shaft, ξ3 gears)."""
+    """Materials and their mean CTE over the warm–cold range (ξ1 housing, ξ2 shaft, ξ3 gears).
+
+    A name sets its coefficient from gearcheck's materials table, the one every mechanism uses
+    ("grey cast iron" is cast iron, 10.5e-6/K); a coefficient given beside it wins (a data
+    sheet's value). A name the table does not know, without a coefficient, is refused."""
 
     housing: str = Field(min_length=1, max_length=MATERIAL_NAME_MAX, description="housing material name")
     housing_cte_per_K: float = _cte_field("housing (ξ1)")
@@ -156,6 +163,36 @@ class Materials(Section):
     shaft_cte_per_K: float = _cte_field("big gear shaft (ξ2)")
     gear: str = Field(min_length=1, max_length=MATERIAL_NAME_MAX, description="gear material name")
     gear_cte_per_K: float = _cte_field("gears (ξ3)")
+    # per member: "given" (the template's coefficient) or the table entry's name it came from
+    _sources: dict[str, str] = PrivateAttr(default_factory=dict)
+
+    @model_validator(mode="wrap")
+    @classmethod
+    def _from_names(cls, data: Any, handler: Any) -> Materials:
+        sources: dict[str, str] = {}
+        if isinstance(data, dict):
+            data = dict(data)
+            for member in MATERIAL_MEMBERS:
+                key = f"{member}_cte_per_K"
+                name = data.get(member)
+                if data.get(key) is not None:
+                    sources[member] = "given"
+                elif isinstance(name, str):
+                    found = materials.find(name)
+                    if found is None:
+                        raise ParamError(f"materials.{member}", name,
+                                         f"allowed a material gearcheck knows ({', '.join(materials.NAMES)}), "
+                                         f"or give materials.{key}")
+                    data[key] = found.cte_per_K
+                    sources[member] = found.name
+        model = handler(data)
+        model._sources = sources
+        return model
+
+    @property
+    def cte_sources(self) -> dict[str, str]:
+        """Where each coefficient comes from: ``"given"`` or the materials table's entry."""
+        return dict(self._sources)
 
 
 class Dimensions(Section):
@@ -218,7 +255,7 @@ class Shim(Section):
                                 json_schema_extra=_unit("mm"))
     study_mm: list[float] = Field(
         default_factory=list, max_length=MAX_STUDY_SHIMS,
-        description="shims to tabulate (the paper's test: 0, 0.05, 0.10, 0.15)", json_schema_extra=_unit("mm"),
+        description="shim thicknesses to tabulate", json_schema_extra=_unit("mm"),
     )
 
     @model_validator(mode="after")
@@ -348,6 +385,17 @@ class Params(Section):
     tca: Tca = Field(default_factory=Tca)
     # the thinning solved from [calibration] by the validation (None: the template's [backlash])
     _thinning: cal.Thinning | None = PrivateAttr(default=None)
+
+    def resolved(self, data: dict[str, Any]) -> dict[str, Any]:
+        """``data`` with every material's coefficient as the run used it (a name's from the
+        materials table where the template gives none): what params.toml records."""
+        import copy
+
+        out = copy.deepcopy(data)
+        section = out.setdefault("materials", {})
+        for member in MATERIAL_MEMBERS:
+            section[f"{member}_cte_per_K"] = getattr(self.materials, f"{member}_cte_per_K")
+        return out
 
     def design_thinning(self) -> cal.Thinning | None:
         """The tooth thinning solved from [calibration] (None when not calibrated)."""

@@ -30,14 +30,15 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, cast
 
 from gearcheck.geometry.rack_pinion import RackPinionGeometry
 from gearcheck.geometry.rack_pinion_contact import whole_drive
 from gearcheck.mechanisms.steering import analysis as an
 from gearcheck.mechanisms.steering import ends, layout, push
-from gearcheck.drafting import Draft, positive_number, teeth_numbers
-from gearcheck.params import ParamError
+from gearcheck.drafting import Draft, in_field_range, positive_number, teeth_numbers
+from gearcheck.params import ParamError, validate
+from gearcheck.params.bounds import fmt_range
 
 # The basic profiles and design rules when --set gives none: the paper's (its α and ε rule, its
 # 60° power-steering and 100° towing requirements; a standard 1 / 1.25 basic rack).
@@ -183,8 +184,16 @@ def _chain(base: Mapping[str, Any], given: Mapping[str, Any], n: int) -> _Chain:
     g = _untrimmed(v, notes, given)
     g = _drive_trims(g, v, notes, given)
     _tops(g, v, notes, given)
-    for key in ("trim.hS2_mm", "trim.hS4_mm", "trim.hS6_mm", "trim.hS8_mm", "pinion.topped_radius_mm"):
-        v[key] = _r(v[key])
+    top = g.rack_top_height
+    for key, bound in (("trim.hS2_mm", top), ("trim.hS4_mm", top), ("trim.hS6_mm", top), ("trim.hS8_mm", top),
+                       ("pinion.topped_radius_mm", g.tip_radius)):
+        # rounding never lifts a value past the rack top (the tip circle): an untrimmed top in floats
+        # (21.464999999999996 mm) is written on the 1 µm grid below it, not rounded up to 21.465
+        rounded = _r(v[key])
+        if rounded > bound:
+            rounded = _r(math.floor(bound / RESOLUTION_MM) * RESOLUTION_MM)
+            notes[key] = f"{notes.get(key, '')}, on the {RESOLUTION_MM * 1000:g} µm grid below it"
+        v[key] = rounded
     chain = _Chain(v, notes)
     _verify(chain)
     return chain
@@ -239,10 +248,26 @@ def _given(given: Mapping[str, Any], notes: dict[str, str], key: str, note: str 
     return float(given[key])
 
 
+def _given_in_drawing(g: RackPinionGeometry, given: Mapping[str, Any]) -> None:
+    """Derived values set with --set lie where the chain's constructions exist (the template's
+    rules, :mod:`.params`): a trim between the rolling line and the rack top, RS1 between the form
+    circle and the tip circle. NoDesign names the value and that range."""
+    h, top = g.made_rolling_line_height, g.rack_top_height
+    for key in ("trim.hS2_mm", "trim.hS4_mm", "trim.hS6_mm", "trim.hS8_mm"):
+        if key in given and not h < given[key] <= top:
+            raise NoDesign(f"a trim lies above the rolling line, at most at the rack tooth top: allowed "
+                           f"{fmt_range(h, top, lo_open=True)} mm", key)
+    key = "pinion.topped_radius_mm"
+    if key in given and not g.form_radius < given[key] <= g.tip_radius:
+        raise NoDesign(f"RS1 lies above the form circle, at most at the tip radius: allowed "
+                       f"{fmt_range(g.form_radius, g.tip_radius, lo_open=True)} mm", key)
+
+
 def _drive_trims(g: RackPinionGeometry, v: dict[str, Any], notes: dict[str, str],
                  given: Mapping[str, Any]) -> RackPinionGeometry:
     """Steps 4–6: hS4 from ε, RS1 from the target, hS2 for the shortest stroke."""
     top, eps = g.rack_top_height, v["trim.min_contact_ratio"]
+    _given_in_drawing(g, given)
     hs4 = _given(given, notes, "trim.hS4_mm")
     if hs4 is not None:
         notes["trim.hS4_mm"] = f"as given: ε = {an.contact_ratio(g, hs4):.4f}"
@@ -316,17 +341,14 @@ def _verify(chain: _Chain) -> None:
     that fails)."""
     from gearcheck.mechanisms.steering.params import Params
 
-    v = chain.values
-    sections: dict[str, dict[str, Any]] = {}
-    for dotted, value in v.items():
-        section, _, key = dotted.partition(".")
-        sections.setdefault(section, {})[key] = value
+    written = Draft("steering", "verify")  # the values as the template will hold them
+    for dotted, value in chain.values.items():
+        written.set(dotted, value)
+    sections = {k: v for k, v in written.data().items() if k not in ("mechanism", "name")}
     try:
-        params = Params.model_validate(sections)
-    except ParamError as exc:
+        params = cast(Params, validate(Params, sections))  # field ranges and the model's rules, one line each
+    except ParamError as exc:  # several: the first (ParamErrors carries its field, value and range)
         raise NoDesign(f"the derived {exc.field} = {exc.value} breaks a rule: {exc.allowed}") from None
-    except Exception as exc:  # pydantic's field ranges
-        raise NoDesign(f"a derived value is out of range: {str(exc).splitlines()[0]}") from None
     g = an.geometry_from_params(params)
     target = params.targets.continuous_drive_deg
     drive = min(whole_drive(g), key=lambda d: d.angle_rad)
@@ -350,10 +372,13 @@ def _verify(chain: _Chain) -> None:
 
 
 def _number(values: Mapping[str, Any], key: str) -> float:
+    """An input of the derivation set with --set: a number within its template field's range."""
+    from gearcheck.mechanisms.steering.params import Params
+
     value = values[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         raise ParamError(key, value, "allowed a number (an input of the derivation)")
-    return float(value)
+    return in_field_range(Params, key, float(value))
 
 
 def new(inputs: Mapping[str, Any], overrides: Mapping[str, Any]) -> Draft:

@@ -89,14 +89,17 @@ def sweep_meshes(pinion: Body, rack: Body, centre_height_mm: float, flanks: tupl
     return meshes, info
 
 
-def pinion_profile(pinion: MeshData) -> np.ndarray:
+def pinion_profile(pinion: MeshData, root_radius_mm: float, bore_radius_mm: float) -> np.ndarray:
     """The pinion's outline as the mesh has it (own frame, (n, 2), ordered by polar angle): the
     vertices on one end face. Every wall triangle spans the face width, so these are all the
-    profile's vertices (exact points of the B-rep outline); only the teeth are kept."""
+    profile's vertices (exact points of the B-rep outline). The outer outline (teeth, root arcs)
+    is kept and the bore left out: the outline lies on or outside the root circle, the bore
+    strictly inside it, and the cut is made half way between the two (a share of the tip radius
+    would cut a topped end tooth's corner off a small, coarse pinion)."""
     v = pinion.vertices
     ring = v[np.abs(v[:, 2] - v[:, 2].max()) < 1e-6]
     rho = np.hypot(ring[:, 0], ring[:, 1])
-    ring = ring[rho > 0.8 * rho.max()]
+    ring = ring[rho > 0.5 * (root_radius_mm + bore_radius_mm)]
     gamma = np.arctan2(ring[:, 0], -ring[:, 1])
     return ring[np.argsort(gamma), :2]
 

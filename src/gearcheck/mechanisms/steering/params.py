@@ -37,7 +37,7 @@ RACK_ADDENDUM_MIN, RACK_ADDENDUM_MAX = 0.5, 1.5  # rack addendum coefficient (fi
 
 class Pinion(Section):
     module_mm: float = Field(gt=0, le=50,
-        description="Module m (paper: 4; see docs/steering.md for why not 5)", json_schema_extra=MM)
+        description="Module m", json_schema_extra=MM)
     teeth: int = Field(ge=10, le=TEETH_MAX, description="Tooth count z of the full pinion (the sector is part of it)")
     profile_shift: float = Field(ge=-1.0, le=1.0, description="Profile shift coefficient x")
     pressure_angle_deg: float = Field(ge=10.0, le=35.0, description="Pressure angle α", json_schema_extra=DEG)
@@ -71,7 +71,7 @@ class Layout(Section):
 
 class Trim(Section):
     min_contact_ratio: float = Field(ge=1.0, le=3.0,
-        description="Design rule that sets hS4 (paper: 1.2); solved, never checked against the machined heights")
+        description="Design rule that sets hS4: solved, never checked against the machined heights")
     hS2_mm: float = Field(gt=0, le=10000,
         description="Height of S2 above the datum (first rack tooth, drive-side top corner), as machined",
         json_schema_extra=MM)

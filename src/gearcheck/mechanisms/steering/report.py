@@ -59,6 +59,12 @@ def _drive_note(data: SteeringSweep, mode: str) -> str:
     return f"exact model: {model.split(': ', 1)[-1]}; {mesh}"
 
 
+def _least(*values: float) -> float:
+    """The least of the values that are numbers (NaN where none is)."""
+    known = [v for v in values if not math.isnan(v)]
+    return min(known) if known else math.nan
+
+
 def _rows(P: dict, data: SteeringSweep) -> list[Comparison]:
     plus, model, travel_at_adams = data.plus, data.model, data.travel_at_adams_mm
     max_dev = max(plus["max_towing_curve_deviation_mm"], data.minus["max_towing_curve_deviation_mm"])
@@ -86,7 +92,7 @@ def _rows(P: dict, data: SteeringSweep) -> list[Comparison]:
         Comparison("re-engage angle (return swing picks the rack up)", "deg", None, model.reengage_deg,
                    plus["geom_reengage_angle_deg"], "next tooth's trailing flank meets S6; the paper prints no value"),
         Comparison("continuous drive (power mode, contact reaches S6), theory", "deg", P["phi_S6_deg"],
-                   model.continuous_deg, cont, "paper used hS6 = 25.38 from its own lines (62.10° with it)"),
+                   model.power_limit_deg, cont, "paper used hS6 = 25.38 from its own lines (62.10° with it)"),
         Comparison("continuous drive, towing (conjugate contact intervals of every pair, + direction)", "deg",
                    None, model.towing_drive_deg, data.drive("towing", 1).angle_deg, _drive_note(data, "towing")),
         Comparison("continuous drive, power (conjugate contact intervals of every pair, + direction)", "deg", None,
@@ -98,8 +104,9 @@ def _rows(P: dict, data: SteeringSweep) -> list[Comparison]:
         Comparison("continuous drive, whole drive (least of model and mesh, both directions)", "deg", None,
                    min(model.towing_drive_deg, model.power_drive_deg), data.least_drive_deg,
                    "the continuous_drive verdict's figure"),
-        Comparison("continuous drive, test", "deg", P["test_continuous_deg"], model.continuous_deg, cont,
-                   "test includes backlash and deflection"),
+        Comparison("continuous drive (the lesser of the towing S1 end and the power S6), test", "deg",
+                   P["test_continuous_deg"], model.continuous_deg,
+                   _least(plus["geom_towing_conjugate_end_deg"], cont), "test includes backlash and deflection"),
         Comparison("raw FCL nearest point reaches S6 (diagnostic)", "deg", None, model.power_limit_deg,
                    plus["geom_raw_corner_contact_angle_deg"],
                    "vertex/flank and corner/chord contacts swap within the mesh error near the corner: ±1° ambiguity"),

@@ -47,6 +47,10 @@ CONTACT_TOL_MM = 0.02
 TOWING_STEP_DEG = 0.25
 POWER_STEP_DEG = 0.25
 OPTIONS = {"towing_step_deg": TOWING_STEP_DEG, "power_step_deg": POWER_STEP_DEG}
+# A step given in ``options`` is cut to at most this share of the angular pitch: a tooth that moves
+# most of a pitch between two poses is pushed past a rack tooth, and the sweep loses the mesh (the
+# defaults are below it for every tooth count the template allows).
+MAX_STEP_PITCHES = 1.0 / 3.0
 # Reach of one towing push: the push model's bound (tip radius / PUSH_NORMAL_MIN per radian) times
 # the angle step, plus the contact tolerance (a pose that starts in contact). Power mode: the
 # rack turns the pinion at most REACH_MARGIN / (centre height − rack top) rad per mm.
@@ -148,6 +152,8 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     opts.update(options or {})
     layout = assembly.layout
     g = layout.geometry
+    for key in ("towing_step_deg", "power_step_deg"):
+        opts[key] = min(float(opts[key]), MAX_STEP_PITCHES * math.degrees(g.angular_pitch))
     paper = an.is_paper_design(params)
     # a pose at the angle of the paper's ADAMS stop, for the comparison beside the paper's own design
     adams = (an.PAPER["adams_disengage_deg"],) if paper else ()
@@ -168,7 +174,8 @@ def plan(params, assembly: Assembly, bodies: Mapping[str, Body], options: Mappin
     rack_top = float(rack.mesh.vertices[:, 1].max())
     corner = layout.s6_corner
     normal, up = ms.driving_flank(g, rack.mesh, flanks[1], corner)
-    profile = ms.pinion_profile(pinion.mesh)
+    bore = assembly.solids[PINION].bore_diameter_mm / 2.0
+    profile = ms.pinion_profile(pinion.mesh, g.root_radius, bore)
 
     # extra poses around every tight hand-over the exact model predicts (and inside any gap)
     angles = an.towing_grid(layout.towing_max_angle_deg, opts["towing_step_deg"],

@@ -40,11 +40,11 @@ ROLLER_CHAIN = f"({SCOPE}; for a standard roller chain use mechanism = \"roller_
 GROOVE_ROOM_MIN_MM = 1e-6
 
 class Robot(Section):
-    mass_kg: float = _f(gt=0, hi=100_000, unit="kg", description="total mass incl. payload (paper: 150 kg)")
+    mass_kg: float = _f(gt=0, hi=100_000, unit="kg", description="total mass incl. payload")
     speed_m_s: float = _f(gt=0, hi=50, unit="m/s", description="design travel speed v")
     slope_deg: float = _f(0, lt=90, unit="°", description="slope the robot is meant to climb, α")
-    tracks: int = _f(1, 16, description="tracks sharing the load, n (paper: 2 or 4)")
-    g_m_s2: float = _f(0.1, 30, unit="m/s²", description="gravity; the paper's 234 N implies 10")
+    tracks: int = _f(1, 16, description="tracks sharing the load, n")
+    g_m_s2: float = _f(0.1, 30, unit="m/s²", description="gravity")
 
 
 class Ground(Section):
@@ -58,9 +58,8 @@ class Chain(Section):
     standard roller chain: for one, use mechanism = "roller_chain"."""
 
     pitch_mm: float = _f(gt=0, hi=PITCH_MAX_MM, unit="mm",
-                         description="track pitch p: a link's pins sit two grooves apart (the paper's articulated "
-                                     "track, grooves every half pitch; a standard roller chain is mechanism "
-                                     "roller_chain)")
+                         description="track pitch p: a link's pins sit two grooves apart (an articulated track, "
+                                     "grooves every half pitch; a standard roller chain is mechanism roller_chain)")
     sleeve_diameter_mm: float = _f(gt=0, hi=200, unit="mm", description="sleeve (roller) diameter dR [d1]")
     pin_diameter_mm: float = _f(gt=0, hi=100, unit="mm", description="track pin diameter d")
     sleeve_inner_width_mm: float = _f(gt=0, hi=500, unit="mm",
@@ -82,13 +81,13 @@ class Sprocket(Section):
                     description="teeth z, one groove per tooth, grooves every half track pitch (odd: every other "
                                 "tooth engages and each takes its turn; even: accepted with a warning)")
     initial_pitch_diameter_mm: float = _f(gt=0, hi=10_000, unit="mm",
-                                          description="first estimate of d that z is solved from (paper: 230)")
-    tip_over_pitch_mm: float = _f(0, 100, unit="mm", description="short-tooth rule: de = d + this (paper: 0.4)")
+                                          description="first estimate of d that z is solved from")
+    tip_over_pitch_mm: float = _f(0, 100, unit="mm", description="short-tooth rule: de = d + this")
     seating_radius_mm: float = _f(gt=0, hi=100, unit="mm", description="chosen seating radius ri (ρf)")
     flank_radius_mm: float = _f(gt=0, hi=100_000, unit="mm", description="chosen flank radius re")
     seating_angle_deg: float = _f(gt=90, lt=180, unit="°", description="chosen seating angle α")
     tooth_width_mm: float = _f(gt=0, hi=500, unit="mm", description="width of one tooth row bf1")
-    tooth_rows: int = _f(1, 4, description="rows of teeth (paper: 2)")
+    tooth_rows: int = _f(1, 4, description="rows of teeth")
     middle_groove_width_mm: float = _f(0, 500, unit="mm",
                                        description="annular groove between rows for the guide lugs")
 
@@ -96,14 +95,16 @@ class Sprocket(Section):
 class TrackPlate(Section):
     tip_gap_mm: float = _f(TIP_GAP_MIN_MM, 5, unit="mm",
                            description="chosen gap from tooth tip to a seated link's plate")
-    required_gap_min_mm: float = _f(0, 5, unit="mm", description="paper's required gap, lower end")
-    required_gap_max_mm: float = _f(0, 5, unit="mm", description="paper's required gap, upper end")
+    required_gap_min_mm: float = _f(0, 5, unit="mm",
+                                    description="required gap from the tooth tip to the track plate, lower end")
+    required_gap_max_mm: float = _f(0, 5, unit="mm",
+                                    description="required gap from the tooth tip to the track plate, upper end")
 
 
 class Materials(Section):
     sprocket_E_MPa: float = _f(1_000, 500_000, unit="MPa", description="sprocket modulus E2 (7075-T651)")
     sprocket_poisson: float = _f(0, lt=0.5, description="sprocket Poisson ratio μ2")
-    sleeve_E_MPa: float = _f(1_000, 500_000, unit="MPa", description="sleeve modulus E1 (paper: 7075-T651)")
+    sleeve_E_MPa: float = _f(1_000, 500_000, unit="MPa", description="sleeve modulus E1")
     sleeve_poisson: float = _f(0, lt=0.5, description="sleeve Poisson ratio μ1")
 
 
