@@ -550,3 +550,14 @@ def test_a_closed_pipe_keeps_the_verdicts_exit_code(monkeypatch):
     monkeypatch.setattr(cli, "_decided", [1])
     monkeypatch.setattr(cli, "_quiet_stdout", lambda: None)
     assert cli._failed(BrokenPipeError(32, "Broken pipe"), False) == 1
+
+
+def test_a_key_figure_keeps_its_parenthesis_whole():
+    """Before: "short by 1.902′ (the paper's first-order model meets it" — the key figure was cut at
+    the "; " inside the parenthesis, which then never closed."""
+    from gearcheck.results import Verdict
+
+    shortfall = ("least cold total 8.098′, required ≥ 10′, short by 1.902′ (the paper's first-order model meets "
+                 "it; the exact geometry loses more); more words 3")
+    v = Verdict.of("x", "cold total", False, "m 1", evidence="mesh sweep", shortfall=shortfall)
+    assert v.key_figure == shortfall.split("); ")[0] + ")"

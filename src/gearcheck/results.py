@@ -75,7 +75,7 @@ class Verdict:
         ``measured``)."""
         text = self.shortfall if self.level != "pass" and self.shortfall else self.measured
         for cut in ("; ", " — "):
-            head = text.split(cut, 1)[0]
+            head = _first_clause(text, cut)
             if any(c.isdigit() for c in head):
                 text = head
         return text
@@ -111,6 +111,20 @@ class Verdict:
         from gearcheck.notebook import verdict_html
 
         return verdict_html(self)
+
+
+def _first_clause(text: str, cut: str) -> str:
+    """``text`` up to the first ``cut`` outside brackets (a clause in parentheses stays whole:
+    "short by 1.9′ (the model meets it; the geometry does not)")."""
+    depth = 0
+    for i, c in enumerate(text):
+        if c in "([":
+            depth += 1
+        elif c in ")]":
+            depth = max(0, depth - 1)
+        elif depth == 0 and text.startswith(cut, i):
+            return text[:i]
+    return text
 
 
 @dataclass(frozen=True)
