@@ -30,7 +30,7 @@ __all__ = [
 # name → (module, attribute); resolved lazily by __getattr__
 _LAZY = {
     "load": ("gearcheck.design", "load"),
-    "new": ("gearcheck.drafting", "new"),
+    "new": ("gearcheck.new_template", "new"),
     "study": ("gearcheck.studies.core", "study"),
     "StudyResult": ("gearcheck.studies.core", "StudyResult"),
     "Design": ("gearcheck.design", "Design"),
@@ -48,7 +48,7 @@ if TYPE_CHECKING:
 
     from gearcheck.design import Design, load
     from gearcheck.mechanism import Mechanism
-    from gearcheck.drafting import new
+    from gearcheck.new_template import new
     from gearcheck.params.common import ParamError
     from gearcheck.results import CheckResult, Comparison, Plot, Verdict, WorstPose
     from gearcheck.studies.core import StudyResult, study

@@ -123,8 +123,7 @@ if TYPE_CHECKING:
 
 
 def _display(tenths: bool = False, patient: bool = False) -> Any:
-    """The progress display on stderr (:func:`gearcheck.terminal.display`; ``patient``: piped, a
-    stage's lines begin once it has run a few seconds)."""
+    """The progress display on stderr (``patient``: piped, a stage's lines wait a few seconds)."""
     from gearcheck.terminal import PIPED_PATIENCE_S, display
 
     return display(tenths, PIPED_PATIENCE_S if patient else 0.0)
@@ -387,7 +386,8 @@ def cmd_schema(args) -> int:
 
 def cmd_new(args) -> int:
     """Write a complete template from the numbers that define a design (gearcheck.new)."""
-    from gearcheck.drafting import default_name, draft, new
+    from gearcheck.drafting import default_name, draft
+    from gearcheck.new_template import new
 
     inputs = {"module": args.module, "teeth": args.teeth, "chain": args.chain, "strands": args.strands,
               "step": args.step}

@@ -280,30 +280,7 @@ def new(mechanism: str, *, out: str | Path | None = None, overrides: Mapping[str
         raise ParamError("--out", str(path), "its folder does not exist")
     result.relative_to(path.parent)
     atomic_write_text(path, result.toml())  # an OSError: one OutputError line
-    _schema_beside(path.parent, mechanism)
     return from_data(result.data(), path) if result.complete else None
-
-
-def _schema_beside(folder: Path, mechanism: str) -> Path:
-    """The mechanism's JSON schema at ``folder/schema/MECHANISM.json``, where the template's
-    ``#:schema`` line points (an editor then completes and checks its keys); written when
-    missing or different, left alone when it is the same."""
-    from gearcheck.output import atomic_write_text, output_error
-    from gearcheck.schema import SCHEMA_FOLDER, schema_text
-
-    target = folder / SCHEMA_FOLDER / f"{mechanism}.json"
-    text = schema_text(mechanism)
-    try:
-        if target.read_text(encoding="utf-8") == text:
-            return target
-    except (OSError, UnicodeError):
-        pass
-    try:
-        target.parent.mkdir(exist_ok=True)
-    except OSError as exc:  # e.g. a file named "schema" there
-        raise output_error(exc, target.parent) from None
-    atomic_write_text(target, text)
-    return target
 
 
 def default_name(mechanism: str, inputs: Mapping[str, Any]) -> str:

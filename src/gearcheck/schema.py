@@ -145,6 +145,27 @@ def schema_line(mechanism: str) -> str:
     return f"#:schema ./{SCHEMA_FOLDER}/{mechanism}.json"
 
 
+def write_beside(folder: Path, mechanism: str) -> Path:
+    """The mechanism's JSON schema at ``folder/schema/MECHANISM.json``, where a template's
+    ``#:schema`` line points (an editor then completes and checks its keys); written when
+    missing or different, left alone when it is the same."""
+    from gearcheck.output import atomic_write_text, output_error
+
+    target = folder / SCHEMA_FOLDER / f"{mechanism}.json"
+    text = schema_text(mechanism)
+    try:
+        if target.read_text(encoding="utf-8") == text:
+            return target
+    except (OSError, UnicodeError):
+        pass
+    try:
+        target.parent.mkdir(exist_ok=True)
+    except OSError as exc:  # e.g. a file named "schema" there
+        raise output_error(exc, target.parent) from None
+    atomic_write_text(target, text)
+    return target
+
+
 def schema_of(mechanism_or_template: str) -> str:
     """``gearcheck schema ARG``: the schema text of a mechanism named, or of a template file's
     mechanism; ParamError (one line) for anything else."""
